@@ -1,0 +1,35 @@
+# One-command entry points; each installs missing Debian packages first and is safe to rerun.
+SHELL := /bin/bash
+WS := build/ws
+PKG := hough_plane_detector
+BIN := $(WS)/devel/lib/$(PKG)
+REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
+# Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
+export PATH := /usr/bin:$(PATH)
+
+.PHONY: all deps build test demo bench clean
+
+all: build
+
+deps:
+	@scripts/install_deps.sh
+
+build: deps
+	@mkdir -p $(WS)/src
+	@ln -sfn $(CURDIR) $(WS)/src/$(PKG)
+	catkin_make -C $(WS) -DCMAKE_BUILD_TYPE=Release
+
+test: build
+	@rm -rf $(WS)/build/test_results
+	@catkin_make -C $(WS) run_tests > $(WS)/run_tests.log 2>&1 || true
+	@grep -E "^\[ *(RUN|OK|FAILED|PASSED) *\]|Failure|error:" $(WS)/run_tests.log | grep -v "^\[ *RUN" || true
+	@scripts/test_summary.py $(WS)/build/test_results
+
+demo: build
+	$(BIN)/hough_demo
+
+bench: build
+	$(BIN)/benchmark_detector $(REAL_FRAMES)
+
+clean:
+	rm -rf build

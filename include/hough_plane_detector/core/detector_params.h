@@ -1,0 +1,64 @@
+// Every tuning knob of the detector. Names equal the CLI flags and the ROS parameter names.
+#pragma once
+
+#include <string>
+
+namespace hough_plane_detector
+{
+
+struct DetectorParams
+{
+  // Hough-space resolution preset (paper Table 2): 256, 512, 1024, 2048; 0 = use angle_step/d_step.
+  int resolution = 1024;
+  // Angle step of the (alpha, beta) axes in radians when resolution == 0.
+  double angle_step = 0.0061;
+  // Step of the d axis in metres when resolution == 0.
+  double d_step = 0.0097;
+  // |d| range of the world-frame Hough space in metres; planes farther from the origin are ignored.
+  double max_distance = 10.0;
+
+  // Gaussian blur of the per-frame space and of each global contribution, in cells.
+  double blur_sigma = 1.0;
+  // Odd edge length of the precomputed blur kernel, in cells.
+  int blur_kernel_size = 5;
+  // Odd edge length of the sliding window for peaks and their sub-voxel mean (eq. 6), in cells.
+  int peak_window = 5;
+
+  // Minimum blurred value of a local (per-frame) peak; roughly points voting for one cell.
+  double local_threshold = 150.0;
+  // Minimum number of points in the frame that lie on a local peak's plane for it to be kept.
+  int min_support = 800;
+  // Minimum global value (about the number of frames that saw the plane) to report a plane.
+  double global_threshold = 1.5;
+  // Amount every global cell loses per frame (paper 3.7: 0.01 - 0.1).
+  double thinning_rate = 0.05;
+  // Global cells reaching this value become permanent and stop thinning.
+  double permanence_cap = 20.0;
+
+  // Planes closer than both merge thresholds are one plane (eq. 7-10).
+  double merge_angle = 0.05;
+  double merge_distance = 0.05;
+
+  // Normal estimation: square window and stride in pixels; window must be a multiple of stride.
+  int normal_window = 32;
+  int normal_stride = 8;
+  // Fraction of a window's pixels that must be valid for a normal.
+  double min_valid_fraction = 0.6;
+  // Windows whose curvature (smallest eigenvalue / trace) exceeds this are not planar.
+  double max_curvature = 0.02;
+  // C_noc of eq. 11 assumed for the sensor: windows as rough as its noise still count as planar;
+  // 0 leaves only the curvature test.
+  double sensor_noise = 1.0;
+
+  // A window supports a plane when its centroid is this close (m) and its normal this close (rad).
+  double support_distance = 0.05;
+  double support_angle = 0.2;
+
+  // Returns an empty string when the combination is valid, otherwise what is wrong.
+  std::string validate() const;
+  // Angle and d steps after applying the preset.
+  double effectiveAngleStep() const;
+  double effectiveDStep() const;
+};
+
+}  // namespace hough_plane_detector

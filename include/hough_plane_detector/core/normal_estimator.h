@@ -1,0 +1,74 @@
+// Surface normals of an organized cloud by the covariance (eigen) method over square windows,
+// from an integral image of point moments summed per stride block (paper 3.2).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "hough_plane_detector/core/cloud_view.h"
+
+namespace hough_plane_detector
+{
+
+// Point moments of a set of points: count, sum of p, sum of p p^T (upper triangle).
+struct PointMoments
+{
+  double count = 0.0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+
+  void add(const PointMoments& o);
+  void subtract(const PointMoments& o);
+  Eigen::Vector3d mean() const { return sum / count; }
+  Eigen::Matrix3d covariance() const;
+  // The same points moved by a rigid transform.
+  PointMoments transformed(const Eigen::Isometry3d& transform) const;
+};
+
+// One window whose points are planar: its plane in the world frame.
+struct WindowSample
+{
+  Eigen::Vector3d normal;    // world frame, pointing toward the sensor
+  Eigen::Vector3d centroid;  // world frame
+  double d;                  // normal.p + d = 0
+  int count;                 // valid points in the window
+  int window_x, window_y;    // window position in strides (top-left block)
+};
+
+struct NormalEstimatorConfig
+{
+  int window = 8;
+  int stride = 8;
+  double min_valid_fraction = 0.6;
+  double max_curvature = 0.02;
+  // C_noc of the Kinect model (eq. 11) assumed for the sensor; 0 turns the noise-aware test off.
+  double sensor_noise = 1.0;
+};
+
+// Expected depth noise (eq. 11 plus 1/8-pixel disparity quantization) of a Kinect at depth z.
+double sensorDepthSigma(double depth, double noise_coefficient);
+
+class NormalEstimator
+{
+public:
+  // Fills `samples` with one sample per planar window of the cloud, transformed to the world.
+  void compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, const NormalEstimatorConfig& config,
+               std::vector<WindowSample>& samples);
+
+  // Camera-frame moments of the block grid (stride x stride pixel blocks) of the last cloud.
+  int blocksX() const { return blocks_x_; }
+  int blocksY() const { return blocks_y_; }
+  const PointMoments& block(int bx, int by) const { return blocks_[static_cast<size_t>(by) * blocks_x_ + bx]; }
+  // Number of windows with enough valid points in the last cloud.
+  int validWindows() const { return valid_windows_; }
+
+private:
+  int blocks_x_ = 0, blocks_y_ = 0;
+  int valid_windows_ = 0;
+  std::vector<PointMoments> blocks_;
+  std::vector<PointMoments> integral_;  // (blocks_x_ + 1) x (blocks_y_ + 1) summed-area table
+};
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,140 @@
+// The continuous plane detector of Hulik et al. 2014: per-frame voting into a cache space,
+// Gaussian blur, local peaks, and a persistent global Hough space with thinning (Alg. 1-2).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "hough_plane_detector/core/cloud_view.h"
+#include "hough_plane_detector/core/detector_params.h"
+#include "hough_plane_detector/core/hough_parameterization.h"
+#include "hough_plane_detector/core/normal_estimator.h"
+#include "hough_plane_detector/core/sparse_hough_space.h"
+
+namespace hough_plane_detector
+{
+
+struct DetectedPlane
+{
+  int id = -1;                                        // stable across frames
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit, world frame
+  double d = 0.0;                                     // normal.p + d = 0 in the world frame
+  double strength = 0.0;                              // global Hough value (about frames seen)
+  int support = 0;                                    // points of the current frame on the plane
+  double first_seen = 0.0;                            // stamp of the first frame it was reported
+  double last_seen = 0.0;                             // stamp of the last frame with min_support points
+  Eigen::Vector3d hough = Eigen::Vector3d::Zero();    // canonical (alpha, beta, d) of its peak
+};
+
+struct StageTimings
+{
+  double normals_ms = 0, voting_ms = 0, blur_ms = 0, peaks_ms = 0, global_ms = 0, total_ms = 0;
+};
+
+struct MemoryReport
+{
+  size_t global_bytes = 0;      // top grid + allocated chunks of the persistent space
+  size_t global_chunks = 0;
+  size_t local_bytes = 0;       // per-frame space, as allocated in the last frame
+  size_t dense_bytes = 0;       // a dense float array of the same grid
+  size_t top_level_cells = 0;
+};
+
+struct FrameStats
+{
+  int windows_valid = 0;     // windows with enough valid points
+  int samples = 0;           // planar windows that voted
+  int votes_out_of_range = 0;
+  int cache_cells = 0;       // distinct cells of the unblurred cache space
+  int local_peaks = 0;       // local peaks kept for the global space
+};
+
+class PlaneDetector
+{
+public:
+  // Throws std::invalid_argument naming the problem when params.validate() fails.
+  explicit PlaneDetector(const DetectorParams& params);
+
+  // Adds one organized frame; returns false (map untouched) with `error` set on bad input.
+  bool processFrame(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, double stamp,
+                    std::string* error = nullptr);
+
+  const std::vector<DetectedPlane>& planes() const { return planes_; }
+  const StageTimings& lastTimings() const { return timings_; }
+  const FrameStats& lastStats() const { return stats_; }
+  MemoryReport memory() const;
+  const DetectorParams& params() const { return params_; }
+  const HoughParameterization& parameterization() const { return param_; }
+  const SparseHoughSpace& globalSpace() const { return global_; }
+
+  // Planar windows of the last frame and the id of the plane each lies on (-1: none).
+  const std::vector<WindowSample>& lastSamples() const { return samples_; }
+  const std::vector<int>& lastSampleLabels() const { return sample_labels_; }
+  // Plane id of every stride x stride pixel block of the last frame (-1: none), row-major over
+  // normalEstimator().blocksX() x blocksY(); a block is labelled when its points lie on the plane.
+  const std::vector<int>& lastBlockLabels() const { return block_labels_; }
+  const NormalEstimator& normalEstimator() const { return normals_; }
+
+  // Forgets every plane and empties the global space.
+  void reset();
+
+private:
+  struct Peak
+  {
+    Eigen::Vector3d hough;
+    Eigen::Vector3d normal;
+    double d;
+    double value;
+  };
+
+  void vote();
+  void blurCache();
+  void findLocalPeaks();
+  void updateGlobal(const Eigen::Vector3d& camera_position, double stamp);
+  // Climbs from a cell to the local maximum under the (value, -index) total order.
+  Eigen::Vector3i climb(const SparseHoughSpace& space, Eigen::Vector3i cell) const;
+  bool isWindowMaximum(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const;
+  Eigen::Vector3d subVoxelMean(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const;
+  std::vector<Peak> extractPeaks(const SparseHoughSpace& space, const std::vector<Eigen::Vector3i>& seeds,
+                                 double threshold) const;
+  std::vector<Peak> mergeSimilar(std::vector<Peak> peaks) const;
+  // Index of the plane a window lies on, or -1; sign-invariant.
+  int bestPlaneFor(const WindowSample& sample, const std::vector<Eigen::Vector3d>& normals,
+                   const std::vector<double>& ds) const;
+  // Camera-frame moments of the blocks under `windows` that lie on the world plane (normal, d).
+  PointMoments collectPlaneBlocks(const Eigen::Vector3d& normal, double d, const std::vector<int>& windows,
+                                  std::vector<int>& blocks);
+  // True when the points of a fitted plane scatter no more than the sensor's noise.
+  bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;
+  void addGaussian(SparseHoughSpace& space, const Eigen::Vector3d& hough, float weight, float cap);
+
+  DetectorParams params_;
+  HoughParameterization param_;
+  NormalEstimator normals_;
+  SparseHoughSpace local_;
+  SparseHoughSpace global_;
+  std::vector<float> blur_kernel_;
+  int blur_radius_;
+  int peak_radius_;
+
+  Eigen::Isometry3d camera_to_world_ = Eigen::Isometry3d::Identity();  // of the frame in progress
+  std::vector<WindowSample> samples_;
+  std::vector<int> sample_labels_;
+  std::vector<int> block_labels_;
+  std::vector<int> block_mark_;
+  int mark_generation_ = 0;
+  std::vector<std::pair<uint64_t, float>> votes_;
+  std::vector<std::pair<Eigen::Vector3i, float>> cache_;
+  std::vector<Peak> local_peaks_;
+  std::vector<DetectedPlane> planes_;
+  int next_id_ = 0;
+  StageTimings timings_;
+  FrameStats stats_;
+};
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,101 @@
+// The paper's 2-level Hough space (3.3.1): a top grid of pointers to 16^3-cell chunks that are
+// allocated on first write and freed when they become empty.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+namespace hough_plane_detector
+{
+
+class SparseHoughSpace
+{
+public:
+  static constexpr int kChunkBits = 4;
+  static constexpr int kChunkEdge = 1 << kChunkBits;
+  static constexpr int kChunkCells = kChunkEdge * kChunkEdge * kChunkEdge;
+
+  SparseHoughSpace(int size_x, int size_y, int size_z);
+
+  int sizeX() const { return size_x_; }
+  int sizeY() const { return size_y_; }
+  int sizeZ() const { return size_z_; }
+  bool inBounds(int x, int y, int z) const
+  {
+    return x >= 0 && y >= 0 && z >= 0 && x < size_x_ && y < size_y_ && z < size_z_;
+  }
+
+  // Value of a cell; 0 outside the space or in an unallocated chunk.
+  float value(int x, int y, int z) const
+  {
+    if (!inBounds(x, y, z)) return 0.0f;
+    const float* chunk = chunks_[chunkIndex(x, y, z)].get();
+    return chunk ? chunk[cellIndex(x, y, z)] : 0.0f;
+  }
+  void add(int x, int y, int z, float v);
+
+  // Adds weight * kx[i] * ky[j] * kz[k] around (x, y, z), kernels of 2 * radius + 1 taps;
+  // no cell grows past max_value (the global space's permanence cap).
+  void addSeparable(int x, int y, int z, int radius, const float* kx, const float* ky, const float* kz, float weight,
+                    float max_value = std::numeric_limits<float>::max());
+
+  // Subtracts `rate` from every cell below `cap` (never below 0) and frees chunks left empty.
+  void thin(float rate, float cap);
+  // Frees every chunk (kept in a pool for reuse, which is not counted as used memory).
+  void clear();
+
+  size_t chunkCount() const { return allocated_.size(); }
+  size_t topLevelCount() const { return chunks_.size(); }
+  // Bytes held by the top grid and the allocated chunks (the reuse pool is reported apart).
+  size_t bytesUsed() const;
+  size_t bytesPooled() const { return pool_.size() * sizeof(float) * kChunkCells; }
+  // Bytes a dense float array of the same size would need.
+  size_t denseBytes() const;
+
+  // Calls f(x, y, z, value) for every non-zero cell.
+  template <class F>
+  void forEachNonZero(F f) const
+  {
+    for (int chunk_index : allocated_)
+    {
+      const float* chunk = chunks_[chunk_index].get();
+      const int cz = chunk_index % chunks_z_, cy = (chunk_index / chunks_z_) % chunks_y_,
+                cx = chunk_index / (chunks_z_ * chunks_y_);
+      for (int i = 0; i < kChunkCells; ++i)
+      {
+        if (chunk[i] == 0.0f) continue;
+        f((cx << kChunkBits) | (i >> (2 * kChunkBits)), (cy << kChunkBits) | ((i >> kChunkBits) & (kChunkEdge - 1)),
+          (cz << kChunkBits) | (i & (kChunkEdge - 1)), chunk[i]);
+      }
+    }
+  }
+
+  // Raw chunk access for saving and loading maps.
+  const std::vector<int>& allocatedChunkIndices() const { return allocated_; }
+  const float* chunkData(int chunk_index) const { return chunks_[chunk_index].get(); }
+  float* allocateChunk(int chunk_index);
+
+private:
+  static constexpr size_t kMaxPooledChunks = 256;
+  void release(int chunk_index);
+  int chunkIndex(int x, int y, int z) const
+  {
+    return ((x >> kChunkBits) * chunks_y_ + (y >> kChunkBits)) * chunks_z_ + (z >> kChunkBits);
+  }
+  static int cellIndex(int x, int y, int z)
+  {
+    constexpr int m = kChunkEdge - 1;
+    return ((x & m) << (2 * kChunkBits)) | ((y & m) << kChunkBits) | (z & m);
+  }
+
+  int size_x_, size_y_, size_z_;
+  int chunks_x_, chunks_y_, chunks_z_;
+  std::vector<std::unique_ptr<float[]>> chunks_;
+  std::vector<int> allocated_;
+  std::vector<std::unique_ptr<float[]>> pool_;
+};
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,22 @@
+// Detector parameters as command-line flags (the names dynamic_reconfigure uses) and the
+// one-JSON-object-per-frame output of the offline tools.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "hough_plane_detector/core/plane_detector.h"
+
+namespace hough_plane_detector
+{
+
+// Sets the parameter `name` from text; false with `error` set for an unknown name or bad value.
+bool setDetectorParam(DetectorParams& params, const std::string& name, const std::string& value, std::string* error);
+// "name (type, default)" lines for --help.
+std::vector<std::string> detectorParamHelp();
+
+// {"frame": 0, "stamp": 12.34, "frame_id": "odom", "ms": 4.2, "planes": [...]}
+std::string frameToJson(int frame, double stamp, const std::string& frame_id, double ms,
+                        const std::vector<DetectedPlane>& planes);
+
+}  // namespace hough_plane_detector

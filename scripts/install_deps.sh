@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the build, the tests and the demo need; does nothing when all
+# are present, so it is safe to run any number of times.
+set -euo pipefail
+packages=(
+  build-essential cmake catkin ros-message-generation libroscpp-dev librosbag-dev libpcl-ros-dev
+  libpcl-conversions-dev libpcl-dev libeigen3-dev libtf2-dev libtf2-ros-dev libtf2-eigen-dev libtf2-msgs-dev
+  libsensor-msgs-dev libgeometry-msgs-dev libgtest-dev ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-tf2-msgs
+  python3-rostest python3-rosbag python3-catkin-pkg
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+echo "installing missing Debian packages: ${missing[*]}"
+sudo=""
+[ "$(id -u)" -ne 0 ] && sudo="sudo"
+$sudo apt-get update
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,193 @@
+#include "hough_plane_detector/core/normal_estimator.h"
+
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+namespace hough_plane_detector
+{
+
+void PointMoments::add(const PointMoments& o)
+{
+  count += o.count;
+  sum += o.sum;
+  xx += o.xx; xy += o.xy; xz += o.xz; yy += o.yy; yz += o.yz; zz += o.zz;
+}
+
+void PointMoments::subtract(const PointMoments& o)
+{
+  count -= o.count;
+  sum -= o.sum;
+  xx -= o.xx; xy -= o.xy; xz -= o.xz; yy -= o.yy; yz -= o.yz; zz -= o.zz;
+}
+
+Eigen::Matrix3d PointMoments::covariance() const
+{
+  const Eigen::Vector3d m = mean();
+  Eigen::Matrix3d c;
+  c << xx / count - m.x() * m.x(), xy / count - m.x() * m.y(), xz / count - m.x() * m.z(),
+       0, yy / count - m.y() * m.y(), yz / count - m.y() * m.z(),
+       0, 0, zz / count - m.z() * m.z();
+  c(1, 0) = c(0, 1);
+  c(2, 0) = c(0, 2);
+  c(2, 1) = c(1, 2);
+  return c;
+}
+
+PointMoments PointMoments::transformed(const Eigen::Isometry3d& transform) const
+{
+  // sum (R p + t)(R p + t)^T = R S R^T + R s t^T + t s^T R^T + n t t^T
+  const Eigen::Matrix3d r = transform.linear();
+  const Eigen::Vector3d t = transform.translation();
+  Eigen::Matrix3d s;
+  s << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  const Eigen::Vector3d rs = r * sum;
+  const Eigen::Matrix3d out = r * s * r.transpose() + rs * t.transpose() + t * rs.transpose() + count * t * t.transpose();
+  PointMoments m;
+  m.count = count;
+  m.sum = rs + count * t;
+  m.xx = out(0, 0); m.xy = out(0, 1); m.xz = out(0, 2); m.yy = out(1, 1); m.yz = out(1, 2); m.zz = out(2, 2);
+  return m;
+}
+
+double sensorDepthSigma(double depth, double noise_coefficient)
+{
+  if (noise_coefficient <= 0.0) return 0.0;
+  const double z_mm = depth * 1000.0;
+  const double eq11 = std::max(0.0, 2.6610e-6 * z_mm * z_mm * noise_coefficient * noise_coefficient -
+                                        1.0787e-3 * z_mm * noise_coefficient + 2.7011) / 1000.0;
+  // Kinect disparity: f = 580 px, baseline 0.075 m, 1/8 px steps; a uniform step has std step/sqrt(12).
+  const double quantization_step = depth * depth / (580.0 * 0.075 * 8.0);
+  return std::sqrt(eq11 * eq11 + quantization_step * quantization_step / 12.0);
+}
+
+void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
+                              const NormalEstimatorConfig& config, std::vector<WindowSample>& samples)
+{
+  samples.clear();
+  valid_windows_ = 0;
+  const int s = config.stride;
+  blocks_x_ = cloud.width / s;
+  blocks_y_ = cloud.height / s;
+  blocks_.assign(static_cast<size_t>(blocks_x_) * blocks_y_, PointMoments());
+  if (blocks_x_ == 0 || blocks_y_ == 0) return;
+
+  // Per block, float sums relative to the block's first valid point keep full precision
+  // (sums of squares of metres in float would swamp millimetre noise); doubles after that.
+  struct BlockAccumulator
+  {
+    float rx, ry, rz;
+    int n;
+    float sx, sy, sz, xx, xy, xz, yy, yz, zz;
+  };
+  std::vector<BlockAccumulator> row_blocks(blocks_x_);
+  for (int by = 0; by < blocks_y_; ++by)
+  {
+    for (auto& b : row_blocks) b = BlockAccumulator{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    for (int v = by * s; v < (by + 1) * s; ++v)
+    {
+      const uint8_t* row = cloud.data + static_cast<size_t>(v) * cloud.row_step;
+      for (int bx = 0; bx < blocks_x_; ++bx)
+      {
+        BlockAccumulator& b = row_blocks[bx];
+        const uint8_t* p = row + static_cast<size_t>(bx * s) * cloud.point_step;
+        for (int i = 0; i < s; ++i, p += cloud.point_step)
+        {
+          float x, y, z;
+          std::memcpy(&x, p + cloud.x_offset, sizeof(float));
+          std::memcpy(&y, p + cloud.y_offset, sizeof(float));
+          std::memcpy(&z, p + cloud.z_offset, sizeof(float));
+          if (!(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) continue;
+          if (b.n == 0)
+          {
+            b.rx = x; b.ry = y; b.rz = z;
+          }
+          const float qx = x - b.rx, qy = y - b.ry, qz = z - b.rz;
+          ++b.n;
+          b.sx += qx; b.sy += qy; b.sz += qz;
+          b.xx += qx * qx; b.xy += qx * qy; b.xz += qx * qz;
+          b.yy += qy * qy; b.yz += qy * qz; b.zz += qz * qz;
+        }
+      }
+    }
+    for (int bx = 0; bx < blocks_x_; ++bx)
+    {
+      const BlockAccumulator& b = row_blocks[bx];
+      PointMoments& m = blocks_[static_cast<size_t>(by) * blocks_x_ + bx];
+      if (b.n == 0) continue;
+      // Shift the relative sums back to the origin: S = Q + r q^T + q r^T + n r r^T.
+      const double n = b.n, rx = b.rx, ry = b.ry, rz = b.rz;
+      m.count = n;
+      m.sum = Eigen::Vector3d(b.sx + n * rx, b.sy + n * ry, b.sz + n * rz);
+      m.xx = b.xx + 2.0 * rx * b.sx + n * rx * rx;
+      m.yy = b.yy + 2.0 * ry * b.sy + n * ry * ry;
+      m.zz = b.zz + 2.0 * rz * b.sz + n * rz * rz;
+      m.xy = b.xy + rx * b.sy + ry * b.sx + n * rx * ry;
+      m.xz = b.xz + rx * b.sz + rz * b.sx + n * rx * rz;
+      m.yz = b.yz + ry * b.sz + rz * b.sy + n * ry * rz;
+    }
+  }
+
+  // Summed-area table over blocks: a window of k x k blocks costs four look-ups.
+  const int k = config.window / s;
+  const int ix = blocks_x_ + 1;
+  if (k > 1) integral_.assign(static_cast<size_t>(ix) * (blocks_y_ + 1), PointMoments());
+  for (int by = 0; by < blocks_y_ && k > 1; ++by)
+  {
+    PointMoments row_sum;
+    for (int bx = 0; bx < blocks_x_; ++bx)
+    {
+      row_sum.add(blocks_[static_cast<size_t>(by) * blocks_x_ + bx]);
+      PointMoments& cell = integral_[static_cast<size_t>(by + 1) * ix + bx + 1];
+      cell = integral_[static_cast<size_t>(by) * ix + bx + 1];
+      cell.add(row_sum);
+    }
+  }
+
+  const double min_count = config.min_valid_fraction * config.window * config.window;
+  const Eigen::Matrix3d rotation = camera_to_world.linear();
+  const Eigen::Vector3d translation = camera_to_world.translation();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  for (int wy = 0; wy + k <= blocks_y_; ++wy)
+  {
+    for (int wx = 0; wx + k <= blocks_x_; ++wx)
+    {
+      PointMoments m;
+      if (k == 1)
+      {
+        m = blocks_[static_cast<size_t>(wy) * blocks_x_ + wx];
+      }
+      else
+      {
+        m = integral_[static_cast<size_t>(wy + k) * ix + wx + k];
+        m.subtract(integral_[static_cast<size_t>(wy) * ix + wx + k]);
+        m.subtract(integral_[static_cast<size_t>(wy + k) * ix + wx]);
+        m.add(integral_[static_cast<size_t>(wy) * ix + wx]);
+      }
+      if (m.count < min_count) continue;
+      ++valid_windows_;
+      const Eigen::Matrix3d cov = m.covariance();
+      solver.computeDirect(cov);
+      const Eigen::Vector3d eigenvalues = solver.eigenvalues();
+      const double trace = eigenvalues.sum();
+      if (!(trace > 0.0)) continue;
+      const Eigen::Vector3d mean = m.mean();
+      // Planar when flat relative to its size, or no rougher than the sensor's noise at that
+      // depth (far windows of a Kinect are never flat in the first sense).
+      const double noise = 3.0 * sensorDepthSigma(mean.z(), config.sensor_noise);
+      if (eigenvalues(0) > config.max_curvature * trace && eigenvalues(0) > noise * noise) continue;
+      Eigen::Vector3d normal = solver.eigenvectors().col(0);
+      if (normal.dot(mean) > 0.0) normal = -normal;  // toward the sensor at the origin
+      WindowSample sample;
+      sample.normal = rotation * normal;
+      sample.centroid = rotation * mean + translation;
+      sample.d = -sample.normal.dot(sample.centroid);
+      sample.count = static_cast<int>(m.count);
+      sample.window_x = wx;
+      sample.window_y = wy;
+      samples.push_back(sample);
+    }
+  }
+}
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,558 @@
+#include "hough_plane_detector/core/plane_detector.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_set>
+
+#include <Eigen/Eigenvalues>
+
+namespace hough_plane_detector
+{
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start)
+{
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+int marginCells(const DetectorParams& p)
+{
+  // Enough mirrored cells that blur, peak window and sub-voxel mean never see a cut border.
+  return p.blur_kernel_size / 2 + p.peak_window / 2 + 2;
+}
+
+// Angle between two planes' normals regardless of their sign.
+double unsignedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+  return std::acos(std::min(1.0, std::abs(a.dot(b))));
+}
+
+bool isFiniteTransform(const Eigen::Isometry3d& t)
+{
+  if (!t.matrix().allFinite()) return false;
+  const Eigen::Matrix3d r = t.linear();
+  return (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-3 && r.determinant() > 0.0;
+}
+}  // namespace
+
+PlaneDetector::PlaneDetector(const DetectorParams& params)
+  : params_(params)
+  , param_(params.effectiveAngleStep(), params.effectiveDStep(), params.max_distance, marginCells(params))
+  , local_(param_.sizeAngle(), param_.sizeAngle(), param_.sizeD())
+  , global_(param_.sizeAngle(), param_.sizeAngle(), param_.sizeD())
+{
+  const std::string problem = params.validate();
+  if (!problem.empty()) throw std::invalid_argument("invalid detector parameters: " + problem);
+  blur_radius_ = params_.blur_kernel_size / 2;
+  peak_radius_ = params_.peak_window / 2;
+  // Precomputed once (paper 3.3.2); maximum 1, so a lone vote of weight w blurs to peak w.
+  blur_kernel_.resize(2 * blur_radius_ + 1);
+  for (int i = -blur_radius_; i <= blur_radius_; ++i)
+    blur_kernel_[i + blur_radius_] = static_cast<float>(std::exp(-0.5 * i * i / (params_.blur_sigma * params_.blur_sigma)));
+}
+
+void PlaneDetector::reset()
+{
+  global_.clear();
+  local_.clear();
+  planes_.clear();
+  samples_.clear();
+  sample_labels_.clear();
+  next_id_ = 0;
+}
+
+MemoryReport PlaneDetector::memory() const
+{
+  MemoryReport report;
+  report.global_bytes = global_.bytesUsed();
+  report.global_chunks = global_.chunkCount();
+  report.local_bytes = local_.bytesUsed();
+  report.dense_bytes = global_.denseBytes();
+  report.top_level_cells = global_.topLevelCount();
+  return report;
+}
+
+bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, double stamp,
+                                 std::string* error)
+{
+  auto fail = [error](const std::string& what) {
+    if (error) *error = what;
+    return false;
+  };
+  if (!cloud.data || cloud.width <= 0 || cloud.height <= 0) return fail("cloud is empty");
+  if (!isFiniteTransform(camera_to_world)) return fail("camera-to-world transform is not a finite rigid transform");
+  if (!std::isfinite(stamp)) return fail("stamp is not finite");
+  if (cloud.width < params_.normal_window || cloud.height < params_.normal_window)
+    return fail("cloud of " + std::to_string(cloud.width) + " x " + std::to_string(cloud.height) +
+                " is smaller than one normal window of " + std::to_string(params_.normal_window) + " pixels");
+
+  timings_ = StageTimings();
+  stats_ = FrameStats();
+  camera_to_world_ = camera_to_world;
+  const auto frame_start = Clock::now();
+
+  auto t = Clock::now();
+  NormalEstimatorConfig normal_config;
+  normal_config.window = params_.normal_window;
+  normal_config.stride = params_.normal_stride;
+  normal_config.min_valid_fraction = params_.min_valid_fraction;
+  normal_config.max_curvature = params_.max_curvature;
+  normal_config.sensor_noise = params_.sensor_noise;
+  normals_.compute(cloud, camera_to_world, normal_config, samples_);
+  stats_.windows_valid = normals_.validWindows();
+  stats_.samples = static_cast<int>(samples_.size());
+  timings_.normals_ms = msSince(t);
+
+  t = Clock::now();
+  vote();
+  timings_.voting_ms = msSince(t);
+
+  t = Clock::now();
+  blurCache();
+  timings_.blur_ms = msSince(t);
+
+  t = Clock::now();
+  findLocalPeaks();
+  timings_.peaks_ms = msSince(t);
+
+  t = Clock::now();
+  updateGlobal(camera_to_world.translation(), stamp);
+  timings_.global_ms = msSince(t);
+  timings_.total_ms = msSince(frame_start);
+  return true;
+}
+
+void PlaneDetector::vote()
+{
+  votes_.clear();
+  const float overlap = static_cast<float>(params_.normal_stride * params_.normal_stride) /
+                        static_cast<float>(params_.normal_window * params_.normal_window);
+  const uint64_t sy = global_.sizeY(), sz = global_.sizeZ();
+  auto push = [&](const Eigen::Vector3d& hough, float weight) {
+    const Eigen::Vector3d c = param_.toCell(hough);
+    const int x = static_cast<int>(std::lround(c.x())), y = static_cast<int>(std::lround(c.y())),
+              z = static_cast<int>(std::lround(c.z()));
+    if (!global_.inBounds(x, y, z))
+    {
+      ++stats_.votes_out_of_range;
+      return;
+    }
+    votes_.emplace_back((static_cast<uint64_t>(x) * sy + y) * sz + z, weight);
+  };
+  for (const WindowSample& sample : samples_)
+  {
+    // One vote per window weighted by its points over the window overlap, so the space
+    // counts points: the paper's one vote per point with far fewer eigen solves.
+    const float weight = static_cast<float>(sample.count) * overlap;
+    const Eigen::Vector3d hough = param_.toHough(sample.normal, sample.d);
+    push(hough, weight);
+    Eigen::Vector3d mirrored;
+    if (param_.mirror(hough, mirrored)) push(mirrored, weight);
+  }
+  // The unblurred cache space (paper 3.3.3): one entry per distinct cell.
+  std::sort(votes_.begin(), votes_.end(),
+            [](const std::pair<uint64_t, float>& a, const std::pair<uint64_t, float>& b) { return a.first < b.first; });
+  cache_.clear();
+  for (size_t i = 0; i < votes_.size();)
+  {
+    const uint64_t key = votes_[i].first;
+    float weight = 0.0f;
+    for (; i < votes_.size() && votes_[i].first == key; ++i) weight += votes_[i].second;
+    const int z = static_cast<int>(key % sz), y = static_cast<int>((key / sz) % sy), x = static_cast<int>(key / (sz * sy));
+    cache_.emplace_back(Eigen::Vector3i(x, y, z), weight);
+  }
+  stats_.cache_cells = static_cast<int>(cache_.size());
+}
+
+void PlaneDetector::blurCache()
+{
+  local_.clear();
+  const float* k = blur_kernel_.data();
+  for (const auto& entry : cache_)
+    local_.addSeparable(entry.first.x(), entry.first.y(), entry.first.z(), blur_radius_, k, k, k, entry.second);
+}
+
+Eigen::Vector3i PlaneDetector::climb(const SparseHoughSpace& space, Eigen::Vector3i cell) const
+{
+  const int64_t sy = space.sizeY(), sz = space.sizeZ();
+  auto index = [&](const Eigen::Vector3i& c) { return (static_cast<int64_t>(c.x()) * sy + c.y()) * sz + c.z(); };
+  float value = space.value(cell.x(), cell.y(), cell.z());
+  for (int step = 0; step < 1000; ++step)
+  {
+    Eigen::Vector3i best = cell;
+    float best_value = value;
+    int64_t best_index = index(cell);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz)
+        {
+          const Eigen::Vector3i n(cell.x() + dx, cell.y() + dy, cell.z() + dz);
+          if (!space.inBounds(n.x(), n.y(), n.z())) continue;
+          const float v = space.value(n.x(), n.y(), n.z());
+          const int64_t i = index(n);
+          if (v > best_value || (v == best_value && i < best_index))
+          {
+            best = n;
+            best_value = v;
+            best_index = i;
+          }
+        }
+    if (best == cell) break;
+    cell = best;
+    value = best_value;
+  }
+  return cell;
+}
+
+bool PlaneDetector::isWindowMaximum(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const
+{
+  const int64_t sy = space.sizeY(), sz = space.sizeZ();
+  const float value = space.value(cell.x(), cell.y(), cell.z());
+  const int64_t own = (static_cast<int64_t>(cell.x()) * sy + cell.y()) * sz + cell.z();
+  const int r = peak_radius_;
+  for (int dx = -r; dx <= r; ++dx)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dz = -r; dz <= r; ++dz)
+      {
+        const int x = cell.x() + dx, y = cell.y() + dy, z = cell.z() + dz;
+        const float v = space.value(x, y, z);
+        if (v > value) return false;
+        if (v == value && v > 0.0f && (static_cast<int64_t>(x) * sy + y) * sz + z < own) return false;
+      }
+  return true;
+}
+
+Eigen::Vector3d PlaneDetector::subVoxelMean(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const
+{
+  // Eq. 6: m(x) = sum h(p) p / sum h(p) over the peak window W(x).
+  Eigen::Vector3d weighted = Eigen::Vector3d::Zero();
+  double total = 0.0;
+  const int r = peak_radius_;
+  for (int dx = -r; dx <= r; ++dx)
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dz = -r; dz <= r; ++dz)
+      {
+        const double v = space.value(cell.x() + dx, cell.y() + dy, cell.z() + dz);
+        weighted += v * Eigen::Vector3d(dx, dy, dz);
+        total += v;
+      }
+  return cell.cast<double>() + (total > 0.0 ? Eigen::Vector3d(weighted / total) : Eigen::Vector3d::Zero());
+}
+
+std::vector<PlaneDetector::Peak> PlaneDetector::extractPeaks(const SparseHoughSpace& space,
+                                                             const std::vector<Eigen::Vector3i>& seeds,
+                                                             double threshold) const
+{
+  std::vector<Peak> peaks;
+  std::unordered_set<int64_t> visited;
+  const int64_t sy = space.sizeY(), sz = space.sizeZ();
+  for (const Eigen::Vector3i& seed : seeds)
+  {
+    const Eigen::Vector3i top = climb(space, seed);
+    if (!visited.insert((static_cast<int64_t>(top.x()) * sy + top.y()) * sz + top.z()).second) continue;
+    const float value = space.value(top.x(), top.y(), top.z());
+    if (value < threshold || !isWindowMaximum(space, top)) continue;
+    Peak peak;
+    peak.hough = param_.fromCell(subVoxelMean(space, top));
+    // Mirrored twins outside the canonical half are the same plane: keep one.
+    if (!param_.isCanonical(peak.hough)) continue;
+    param_.fromHough(peak.hough, peak.normal, peak.d);
+    peak.value = value;
+    peaks.push_back(peak);
+  }
+  return peaks;
+}
+
+std::vector<PlaneDetector::Peak> PlaneDetector::mergeSimilar(std::vector<Peak> peaks) const
+{
+  std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.value > b.value; });
+  std::vector<Peak> merged;
+  std::vector<double> weights;
+  for (const Peak& peak : peaks)
+  {
+    bool absorbed = false;
+    for (size_t i = 0; i < merged.size() && !absorbed; ++i)
+    {
+      Peak& m = merged[i];
+      const double sign = m.normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
+      const Eigen::Vector3d n2 = sign * peak.normal;
+      const double d2 = sign * peak.d;
+      // Eq. 7-8: similar when both the normal angle and the d difference are small.
+      if (unsignedAngle(m.normal, n2) > params_.merge_angle || std::abs(m.d - d2) > params_.merge_distance) continue;
+      // Eq. 9-10: strength-weighted mean of normal and d.
+      const double w1 = weights[i], w2 = peak.value;
+      m.normal = ((w1 * m.normal + w2 * n2) / (w1 + w2)).normalized();
+      m.d = (w1 * m.d + w2 * d2) / (w1 + w2);
+      weights[i] = w1 + w2;
+      absorbed = true;
+    }
+    if (!absorbed)
+    {
+      merged.push_back(peak);
+      weights.push_back(peak.value);
+    }
+  }
+  for (Peak& m : merged) m.hough = param_.toHough(m.normal, m.d);
+  return merged;
+}
+
+int PlaneDetector::bestPlaneFor(const WindowSample& sample, const std::vector<Eigen::Vector3d>& normals,
+                                const std::vector<double>& ds) const
+{
+  const double cos_limit = std::cos(params_.support_angle);
+  int best = -1;
+  double best_distance = params_.support_distance;
+  for (size_t i = 0; i < normals.size(); ++i)
+  {
+    if (std::abs(sample.normal.dot(normals[i])) < cos_limit) continue;
+    const double distance = std::abs(normals[i].dot(sample.centroid) + ds[i]);
+    if (distance <= best_distance)
+    {
+      best_distance = distance;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
+
+PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, double d,
+                                              const std::vector<int>& windows, std::vector<int>& blocks)
+{
+  // Blocks covered by the windows, each once, whose points lie on the plane.
+  const int k = params_.normal_window / params_.normal_stride;
+  const int bx_count = normals_.blocksX();
+  block_mark_.resize(static_cast<size_t>(bx_count) * normals_.blocksY(), 0);
+  ++mark_generation_;
+  // The plane in the camera frame, to test block centroids without transforming blocks.
+  const Eigen::Vector3d n_cam = camera_to_world_.linear().transpose() * normal;
+  const double d_cam = d + normal.dot(camera_to_world_.translation());
+  PointMoments moments;
+  blocks.clear();
+  for (int s : windows)
+    for (int by = samples_[s].window_y; by < samples_[s].window_y + k; ++by)
+      for (int bx = samples_[s].window_x; bx < samples_[s].window_x + k; ++bx)
+      {
+        const int b = by * bx_count + bx;
+        if (block_mark_[b] == mark_generation_) continue;
+        block_mark_[b] = mark_generation_;
+        const PointMoments& block = normals_.block(bx, by);
+        if (block.count < 3 || std::abs(n_cam.dot(block.mean()) + d_cam) > params_.support_distance) continue;
+        moments.add(block);
+        blocks.push_back(b);
+      }
+  return moments;
+}
+
+bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const
+{
+  // A curved surface (a pillar, a ball) yields windows and even a whole fit within the sensor
+  // noise, but its two halves tilt apart: split the points across each in-plane axis, fit
+  // each half, and require the halves' normals to agree within merge_angle.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(moments.covariance());
+  const Eigen::Vector3d mean = moments.mean();
+  const int bx_count = normals_.blocksX();
+  for (int axis = 1; axis <= 2; ++axis)
+  {
+    const Eigen::Vector3d direction = solver.eigenvectors().col(axis);
+    PointMoments halves[2];
+    for (int b : blocks)
+    {
+      const PointMoments& block = normals_.block(b % bx_count, b / bx_count);
+      halves[direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0].add(block);
+    }
+    if (halves[0].count < 3 || halves[1].count < 3) continue;
+    Eigen::Vector3d half_normals[2];
+    for (int h = 0; h < 2; ++h)
+    {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> half_solver;
+      half_solver.computeDirect(halves[h].covariance());
+      half_normals[h] = half_solver.eigenvectors().col(0);
+    }
+    if (unsignedAngle(half_normals[0], half_normals[1]) > params_.merge_angle) return false;
+  }
+  return true;
+}
+
+void PlaneDetector::findLocalPeaks()
+{
+  std::vector<Eigen::Vector3i> seeds;
+  seeds.reserve(cache_.size());
+  for (const auto& entry : cache_) seeds.push_back(entry.first);
+  std::vector<Peak> peaks = extractPeaks(local_, seeds, params_.local_threshold);
+  // The strongest peaks are enough; a frame holds far fewer real planes than this.
+  constexpr size_t kMaxLocalPeaks = 64;
+  std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.value > b.value; });
+  if (peaks.size() > kMaxLocalPeaks) peaks.resize(kMaxLocalPeaks);
+
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<double> ds;
+  for (const Peak& p : peaks)
+  {
+    normals.push_back(p.normal);
+    ds.push_back(p.d);
+  }
+  std::vector<std::vector<int>> peak_windows(peaks.size());
+  for (size_t s = 0; s < samples_.size(); ++s)
+  {
+    const int best = bestPlaneFor(samples_[s], normals, ds);
+    if (best >= 0) peak_windows[best].push_back(static_cast<int>(s));
+  }
+
+  // Refine each peak by a least-squares fit to the points of its windows: per-frame planes
+  // that agree to a fraction of a cell keep the global peaks sharp.
+  std::vector<Peak> supported;
+  std::vector<int> blocks;
+  for (size_t i = 0; i < peaks.size(); ++i)
+  {
+    Eigen::Vector3d normal = peaks[i].normal;
+    double d = peaks[i].d;
+    PointMoments moments;
+    for (int pass = 0; pass < 2; ++pass)
+    {
+      moments = collectPlaneBlocks(normal, d, peak_windows[i], blocks);
+      if (moments.count < std::max(3, params_.min_support)) break;
+      const PointMoments world = moments.transformed(camera_to_world_);
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+      solver.computeDirect(world.covariance());
+      Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
+      if (n.dot(normal) < 0.0) n = -n;
+      normal = n;
+      d = -n.dot(world.mean());
+    }
+    if (moments.count < std::max(3, params_.min_support)) continue;
+    if (!isPlanarFit(moments, blocks)) continue;
+    Peak refined = peaks[i];
+    refined.normal = normal;
+    refined.d = d;
+    refined.hough = param_.toHough(normal, d);
+    supported.push_back(refined);
+  }
+  local_peaks_ = mergeSimilar(supported);
+  stats_.local_peaks = static_cast<int>(local_peaks_.size());
+}
+
+void PlaneDetector::addGaussian(SparseHoughSpace& space, const Eigen::Vector3d& hough, float weight, float cap)
+{
+  // Centred on the sub-voxel position, so the global space keeps what eq. 6 refined.
+  const Eigen::Vector3d c = param_.toCell(hough);
+  const Eigen::Vector3i ci(static_cast<int>(std::lround(c.x())), static_cast<int>(std::lround(c.y())),
+                           static_cast<int>(std::lround(c.z())));
+  const int r = blur_radius_;
+  const double inv = 1.0 / (2.0 * params_.blur_sigma * params_.blur_sigma);
+  float kernels[3][16];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const double frac = c(axis) - ci(axis);
+    for (int i = -r; i <= r; ++i) kernels[axis][i + r] = static_cast<float>(std::exp(-(i - frac) * (i - frac) * inv));
+  }
+  space.addSeparable(ci.x(), ci.y(), ci.z(), r, kernels[0], kernels[1], kernels[2], weight, cap);
+}
+
+void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double stamp)
+{
+  const float cap = static_cast<float>(params_.permanence_cap);
+  // Thinning (3.7) first, so a plane seen in this frame ends the frame at least 1 higher.
+  global_.thin(static_cast<float>(params_.thinning_rate), cap);
+
+  // Algorithm 2: every local peak adds one Gaussian of maximum 1 to the global space.
+  std::vector<Eigen::Vector3i> seeds;
+  auto cellOf = [this](const Eigen::Vector3d& hough) {
+    const Eigen::Vector3d c = param_.toCell(hough);
+    return Eigen::Vector3i(static_cast<int>(std::lround(c.x())), static_cast<int>(std::lround(c.y())),
+                           static_cast<int>(std::lround(c.z())));
+  };
+  for (const Peak& peak : local_peaks_)
+  {
+    addGaussian(global_, peak.hough, 1.0f, cap);
+    Eigen::Vector3d mirrored;
+    if (param_.mirror(peak.hough, mirrored)) addGaussian(global_, mirrored, 1.0f, cap);
+    seeds.push_back(cellOf(peak.hough));
+  }
+  for (const DetectedPlane& plane : planes_) seeds.push_back(cellOf(plane.hough));
+
+  std::vector<Peak> peaks = mergeSimilar(extractPeaks(global_, seeds, params_.global_threshold));
+
+  // Stable ids: each new peak takes the id of the closest previous plane it is similar to.
+  std::vector<DetectedPlane> previous;
+  previous.swap(planes_);
+  std::vector<bool> taken(previous.size(), false);
+  for (const Peak& peak : peaks)
+  {
+    DetectedPlane plane;
+    plane.hough = peak.hough;
+    plane.strength = peak.value;
+    int match = -1;
+    double best_cost = 2.0;
+    for (size_t i = 0; i < previous.size(); ++i)
+    {
+      if (taken[i]) continue;
+      const double cost = unsignedAngle(previous[i].normal, peak.normal) / (2.0 * params_.merge_angle + 1e-9) +
+                          std::abs(std::abs(previous[i].d) - std::abs(peak.d)) / (2.0 * params_.merge_distance + 1e-9);
+      const double sign = previous[i].normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
+      if (std::abs(previous[i].d - sign * peak.d) > 2.0 * params_.merge_distance) continue;
+      if (cost < best_cost)
+      {
+        best_cost = cost;
+        match = static_cast<int>(i);
+      }
+    }
+    double sign;
+    if (match >= 0)
+    {
+      taken[match] = true;
+      plane.id = previous[match].id;
+      plane.first_seen = previous[match].first_seen;
+      plane.last_seen = previous[match].last_seen;
+      sign = previous[match].normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;  // keep the reported side
+    }
+    else
+    {
+      plane.id = next_id_++;
+      plane.first_seen = stamp;
+      plane.last_seen = stamp;
+      sign = peak.normal.dot(camera_position) + peak.d >= 0.0 ? 1.0 : -1.0;  // face the sensor
+    }
+    plane.normal = sign * peak.normal;
+    plane.d = sign * peak.d;
+    planes_.push_back(plane);
+  }
+
+  // Support and labels of this frame: windows go to the plane they agree with, then their
+  // blocks that lie on it count once.
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<double> ds;
+  for (const DetectedPlane& plane : planes_)
+  {
+    normals.push_back(plane.normal);
+    ds.push_back(plane.d);
+  }
+  sample_labels_.assign(samples_.size(), -1);
+  std::vector<std::vector<int>> plane_windows(planes_.size());
+  for (size_t s = 0; s < samples_.size(); ++s)
+  {
+    const int best = bestPlaneFor(samples_[s], normals, ds);
+    if (best < 0) continue;
+    plane_windows[best].push_back(static_cast<int>(s));
+    sample_labels_[s] = planes_[best].id;
+  }
+  block_labels_.assign(static_cast<size_t>(normals_.blocksX()) * normals_.blocksY(), -1);
+  std::vector<int> blocks;
+  for (size_t p = 0; p < planes_.size(); ++p)
+  {
+    const PointMoments moments = collectPlaneBlocks(planes_[p].normal, planes_[p].d, plane_windows[p], blocks);
+    planes_[p].support = static_cast<int>(moments.count);
+    for (int b : blocks) block_labels_[b] = planes_[p].id;
+  }
+  for (DetectedPlane& plane : planes_)
+    if (plane.support >= params_.min_support) plane.last_seen = stamp;
+}
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,58 @@
+#include "hough_plane_detector/core/plane_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace hough_plane_detector
+{
+
+double angleError(const Eigen::Vector3d& normal, const Eigen::Vector3d& true_normal)
+{
+  return std::acos(std::min(1.0, std::abs(normal.normalized().dot(true_normal.normalized()))));
+}
+
+double distanceError(const Eigen::Vector3d& normal, double d, const Eigen::Vector3d& true_normal, double true_d)
+{
+  const double sign = normal.dot(true_normal) >= 0.0 ? 1.0 : -1.0;
+  return std::abs(sign * d - true_d);
+}
+
+FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std::vector<int>& visible_points,
+                           int min_visible_points, const std::vector<EvaluatedPlane>& detections,
+                           const MatchTolerance& tolerance)
+{
+  FrameMetrics m;
+  std::vector<std::tuple<double, size_t, size_t>> pairs;  // cost, true, detection
+  for (size_t t = 0; t < true_planes.size(); ++t)
+    for (size_t k = 0; k < detections.size(); ++k)
+    {
+      const double ea = angleError(detections[k].normal, true_planes[t].normal);
+      const double ed = distanceError(detections[k].normal, detections[k].d, true_planes[t].normal, true_planes[t].d);
+      if (ea <= tolerance.angle && ed <= tolerance.distance)
+        pairs.emplace_back(ea / tolerance.angle + ed / tolerance.distance, t, k);
+    }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<int> true_match(true_planes.size(), -1), detection_match(detections.size(), -1);
+  for (const auto& [cost, t, k] : pairs)
+  {
+    if (true_match[t] >= 0 || detection_match[k] >= 0) continue;
+    true_match[t] = static_cast<int>(k);
+    detection_match[k] = static_cast<int>(t);
+  }
+  for (size_t t = 0; t < true_planes.size(); ++t)
+  {
+    if (t >= visible_points.size() || visible_points[t] < min_visible_points) continue;
+    ++m.visible;
+    if (true_match[t] < 0) continue;
+    ++m.detected;
+    const EvaluatedPlane& det = detections[true_match[t]];
+    m.angle_errors.push_back(angleError(det.normal, true_planes[t].normal));
+    m.d_errors.push_back(distanceError(det.normal, det.d, true_planes[t].normal, true_planes[t].d));
+  }
+  for (int match : detection_match)
+    if (match < 0) ++m.false_detections;
+  return m;
+}
+
+}  // namespace hough_plane_detector

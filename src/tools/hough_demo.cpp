@@ -1,0 +1,110 @@
+// `make demo` without hardware: a simulated Kinect tours a room; the detected planes are
+// printed next to the true ones with the accuracy metrics and ms per frame.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/core/plane_metrics.h"
+#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/tools/cli_options.h"
+
+using namespace hough_plane_detector;
+
+int main(int argc, char** argv)
+{
+  int frames = 40;
+  double noise = 1.0;
+  std::string scene_name = "office";
+  DetectorParams params;
+  for (int i = 1; i + 1 < argc; i += 2)
+  {
+    const std::string name = std::string(argv[i]).substr(2), value = argv[i + 1];
+    std::string error;
+    if (name == "frames") frames = std::atoi(value.c_str());
+    else if (name == "noise") noise = std::atof(value.c_str());
+    else if (name == "scene") scene_name = value;
+    else if (!setDetectorParam(params, name, value, &error))
+    {
+      std::fprintf(stderr, "hough_demo: %s\n", error.c_str());
+      return 2;
+    }
+  }
+  const Scene scene = scene_name == "hall" ? makeRampStairsHall() : makeOfficeRoom();
+  SceneRenderer renderer(scene);
+  PlaneDetector detector(params);
+  KinectNoise kinect;
+  kinect.coefficient = noise;
+  std::vector<double> ms, angle_errors, d_errors;
+  int visible = 0, detected = 0, false_total = 0;
+  const int warmup = 3;
+  std::printf("simulated Kinect, %s scene, noise C = %.2f, %d frames, resolution %d\n", scene_name.c_str(), noise,
+              frames, params.resolution);
+  std::printf("frame  ms     planes  visible  found  false\n");
+  const auto poses = roomTour(frames);
+  for (int f = 0; f < frames; ++f)
+  {
+    const RenderedFrame frame = renderer.render(poses[f], kinect, 1000 + f);
+    std::string error;
+    if (!detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f, &error))
+    {
+      std::fprintf(stderr, "frame %d: %s\n", f, error.c_str());
+      return 1;
+    }
+    ms.push_back(detector.lastTimings().total_ms);
+    std::vector<EvaluatedPlane> evaluated;
+    for (const auto& p : detector.planes()) evaluated.push_back(EvaluatedPlane{p.normal, p.d});
+    const FrameMetrics m = evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluated);
+    const FrameStats& st = detector.lastStats();
+    std::printf("%5d  %5.2f  %6zu  %7d  %5d  %5d   (windows %d, planar %d, cache cells %d, local peaks %d)\n", f,
+                detector.lastTimings().total_ms, detector.planes().size(), m.visible, m.detected, m.false_detections,
+                st.windows_valid, st.samples, st.cache_cells, st.local_peaks);
+    if (f < warmup) continue;
+    visible += m.visible;
+    detected += m.detected;
+    false_total += m.false_detections;
+    angle_errors.insert(angle_errors.end(), m.angle_errors.begin(), m.angle_errors.end());
+    d_errors.insert(d_errors.end(), m.d_errors.begin(), m.d_errors.end());
+  }
+
+  std::printf("\nplanes in the map after %d frames (world frame, n.p + d = 0):\n", frames);
+  std::printf("  id  normal                      d        strength  support  | true plane            E_angle  E_d\n");
+  for (const auto& p : detector.planes())
+  {
+    const TruePlane* best = nullptr;
+    double best_cost = 1e9;
+    for (const auto& t : renderer.truePlanes())
+    {
+      const double cost = angleError(p.normal, t.normal) / 0.08 + distanceError(p.normal, p.d, t.normal, t.d) / 0.07;
+      if (cost < best_cost)
+      {
+        best_cost = cost;
+        best = &t;
+      }
+    }
+    std::printf("  %2d  (%+.3f %+.3f %+.3f)  %+7.3f  %8.2f  %7d  | ", p.id, p.normal.x(), p.normal.y(), p.normal.z(),
+                p.d, p.strength, p.support);
+    if (best && best_cost <= 2.0)
+      std::printf("%-20s  %.4f   %.4f\n", best->name.c_str(), angleError(p.normal, best->normal),
+                  distanceError(p.normal, p.d, best->normal, best->d));
+    else
+      std::printf("(no true plane)\n");
+  }
+  auto mean = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return v.empty() ? 0.0 : s / v.size();
+  };
+  std::sort(ms.begin(), ms.end());
+  const MemoryReport mem = detector.memory();
+  std::printf("\nafter frame %d: E_angle %.4f rad, E_d %.4f m, detected %d of %d visible planes (%.1f %%), "
+              "%.3f false planes per frame\n",
+              warmup, mean(angle_errors), mean(d_errors), detected, visible, visible ? 100.0 * detected / visible : 0.0,
+              static_cast<double>(false_total) / std::max(1, frames - warmup));
+  std::printf("median %.2f ms per frame (%d frames); Hough space %.2f MB = %.3f %% of the dense %.0f MB\n",
+              ms[ms.size() / 2], frames, mem.global_bytes / 1e6, 100.0 * mem.global_bytes / mem.dense_bytes,
+              mem.dense_bytes / 1e6);
+  return 0;
+}

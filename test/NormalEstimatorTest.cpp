@@ -1,0 +1,108 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "hough_plane_detector/core/normal_estimator.h"
+#include "hough_plane_detector/core/scene_renderer.h"
+
+using namespace hough_plane_detector;
+
+namespace
+{
+RenderedFrame renderWall(const Eigen::Isometry3d& pose, double noise)
+{
+  Scene scene;
+  scene.addRectangle({3.0, 0, 1.0}, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 5.0, 5.0, "wall");
+  KinectNoise kinect;
+  kinect.coefficient = noise;
+  kinect.quantize = noise > 0;
+  kinect.gaussian = noise > 0;
+  return SceneRenderer(scene).render(pose, kinect, 3);
+}
+}  // namespace
+
+TEST(NormalEstimator, WindowNormalsOfAPlaneFaceTheSensorInTheWorldFrame)
+{
+  const Eigen::Isometry3d pose = lookAt({0.2, 0.3, 1.0}, {3.0, 1.0, 0.6});
+  const RenderedFrame frame = renderWall(pose, 0.0);
+  NormalEstimator estimator;
+  std::vector<WindowSample> samples;
+  NormalEstimatorConfig config;
+  config.window = 16;
+  config.stride = 8;
+  estimator.compute(frame.view(), pose, config, samples);
+  ASSERT_EQ(estimator.blocksX(), 80);
+  ASSERT_EQ(estimator.blocksY(), 60);
+  ASSERT_GT(samples.size(), 4000u);
+  for (const WindowSample& s : samples)
+  {
+    // Wall x = 3 seen from x < 3: the normal toward the sensor is -x, d = 3.
+    EXPECT_NEAR(s.normal.x(), -1.0, 1e-4);
+    EXPECT_NEAR(s.d, 3.0, 1e-3);
+    EXPECT_NEAR(s.centroid.x(), 3.0, 1e-3);
+    EXPECT_EQ(s.count, 256);
+  }
+}
+
+TEST(NormalEstimator, SkipsWindowsWithTooFewPointsAndCreases)
+{
+  // Half the image NaN, and a corner between the wall and a floor.
+  Scene scene;
+  scene.addRectangle({3.0, 0, 1.0}, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), 5.0, 5.0, "wall");
+  scene.addRectangle({0, 0, 0}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5.0, 5.0, "floor");
+  KinectNoise clean;
+  clean.coefficient = 0.0;
+  clean.quantize = false;
+  clean.gaussian = false;
+  const Eigen::Isometry3d pose = lookAt({0.5, 0, 1.0}, {3.0, 0, 0.0});
+  RenderedFrame frame = SceneRenderer(scene).render(pose, clean, 1);
+  for (int v = 0; v < 480; ++v)
+    for (int u = 320; u < 640; ++u)
+      for (int a = 0; a < 3; ++a) frame.xyz[(v * 640 + u) * 3 + a] = std::numeric_limits<float>::quiet_NaN();
+  NormalEstimator estimator;
+  std::vector<WindowSample> samples;
+  NormalEstimatorConfig config;
+  config.window = 16;
+  config.stride = 8;
+  config.sensor_noise = 0.0;
+  estimator.compute(frame.view(), pose, config, samples);
+  ASSERT_GT(samples.size(), 1000u);
+  for (const WindowSample& s : samples)
+  {
+    // A window needs min_valid_fraction of its pixels, so none reaches far into the NaN half.
+    EXPECT_LE(s.window_x * 8, 320 - config.min_valid_fraction * 16);
+    const bool wall = std::abs(s.normal.x() + 1.0) < 1e-3, floor = std::abs(s.normal.z() - 1.0) < 1e-3;
+    EXPECT_TRUE(wall || floor) << "window across the crease kept: " << s.normal.transpose();
+  }
+}
+
+TEST(NormalEstimator, MomentsTransformLikeThePoints)
+{
+  PointMoments m;
+  const Eigen::Vector3d pts[3] = {{1, 2, 3}, {-1, 0.5, 2}, {0.3, -0.7, 1}};
+  const Eigen::Isometry3d t = Eigen::Translation3d(1, -2, 0.5) * Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized());
+  PointMoments moved_direct;
+  for (const auto& p : pts)
+  {
+    for (auto [target, q] : {std::pair<PointMoments*, Eigen::Vector3d>{&m, p}, {&moved_direct, t * p}})
+    {
+      target->count += 1;
+      target->sum += q;
+      target->xx += q.x() * q.x(); target->xy += q.x() * q.y(); target->xz += q.x() * q.z();
+      target->yy += q.y() * q.y(); target->yz += q.y() * q.z(); target->zz += q.z() * q.z();
+    }
+  }
+  const PointMoments moved = m.transformed(t);
+  EXPECT_NEAR((moved.sum - moved_direct.sum).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((moved.covariance() - moved_direct.covariance()).norm(), 0.0, 1e-12);
+}
+
+TEST(NormalEstimator, SensorNoiseFollowsEquation11)
+{
+  // Paper 4.3: 63.8 mm at 5 m with C = 1.
+  EXPECT_NEAR(kinectNoiseSigma(5.0, 1.0), 0.0638, 0.0005);
+  EXPECT_NEAR(kinectNoiseSigma(1.0, 0.0), 0.0027011, 1e-7);
+  EXPECT_GT(sensorDepthSigma(5.0, 1.0), kinectNoiseSigma(5.0, 1.0));  // plus quantization
+  EXPECT_EQ(sensorDepthSigma(5.0, 0.0), 0.0);
+}

@@ -1,0 +1,369 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/core/plane_metrics.h"
+#include "hough_plane_detector/core/scene_renderer.h"
+
+using namespace hough_plane_detector;
+
+namespace
+{
+const Eigen::Vector3d kX = Eigen::Vector3d::UnitX(), kY = Eigen::Vector3d::UnitY(), kZ = Eigen::Vector3d::UnitZ();
+
+KinectNoise kinect(double c)
+{
+  KinectNoise noise;
+  noise.coefficient = c;
+  return noise;
+}
+
+// Detected planes that are (n, d) within the tolerances, whatever their sign.
+std::vector<const DetectedPlane*> matching(const std::vector<DetectedPlane>& planes, const Eigen::Vector3d& n, double d,
+                                           double angle_tol, double d_tol)
+{
+  std::vector<const DetectedPlane*> out;
+  for (const auto& p : planes)
+    if (angleError(p.normal, n) <= angle_tol && distanceError(p.normal, p.d, n, d) <= d_tol) out.push_back(&p);
+  return out;
+}
+
+void feed(PlaneDetector& detector, const RenderedFrame& frame, double stamp)
+{
+  std::string error;
+  ASSERT_TRUE(detector.processFrame(frame.view(), frame.camera_to_world, stamp, &error)) << error;
+}
+
+std::string describe(const std::vector<DetectedPlane>& planes)
+{
+  std::string s;
+  for (const auto& p : planes)
+    s += "\n  id " + std::to_string(p.id) + " n=(" + std::to_string(p.normal.x()) + ", " + std::to_string(p.normal.y()) +
+         ", " + std::to_string(p.normal.z()) + ") d=" + std::to_string(p.d) + " strength " + std::to_string(p.strength);
+  return s;
+}
+}  // namespace
+
+TEST(PlaneDetector, RefusesInvalidParameters)
+{
+  DetectorParams params;
+  params.normal_window = 12;
+  params.normal_stride = 8;
+  try
+  {
+    PlaneDetector detector(params);
+    FAIL() << "accepted a window that is not a multiple of the stride";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("normal_stride"), std::string::npos) << e.what();
+  }
+}
+
+class RoomAtNoise : public testing::TestWithParam<double>
+{
+};
+
+// Rendered office tour: floor and walls recovered, metrics within the stated tolerances.
+TEST_P(RoomAtNoise, RecoversTheTruePlanes)
+{
+  const double c = GetParam();
+  SceneRenderer renderer(makeOfficeRoom());
+  PlaneDetector detector{DetectorParams()};
+  const auto poses = roomTour(40);
+  int visible = 0, detected = 0, false_detections = 0;
+  double sum_angle = 0, sum_d = 0;
+  int matched = 0;
+  for (size_t f = 0; f < poses.size(); ++f)
+  {
+    const RenderedFrame frame = renderer.render(poses[f], kinect(c), 100 + f);
+    feed(detector, frame, 0.1 * f);
+    if (f < 3) continue;
+    std::vector<EvaluatedPlane> evaluated;
+    for (const auto& p : detector.planes()) evaluated.push_back({p.normal, p.d});
+    const FrameMetrics m = evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluated);
+    visible += m.visible;
+    detected += m.detected;
+    false_detections += m.false_detections;
+    for (size_t i = 0; i < m.angle_errors.size(); ++i)
+    {
+      sum_angle += m.angle_errors[i];
+      sum_d += m.d_errors[i];
+      ++matched;
+    }
+  }
+  for (const std::string name : {"floor", "wall_east", "wall_west", "wall_north", "wall_south"})
+  {
+    const TruePlane* truth = nullptr;
+    for (const auto& t : renderer.truePlanes())
+      if (t.name == name) truth = &t;
+    ASSERT_NE(truth, nullptr);
+    EXPECT_EQ(matching(detector.planes(), truth->normal, truth->d, 0.01, 0.02).size(), 1u)
+        << name << " at C = " << c << describe(detector.planes());
+  }
+  ASSERT_GT(matched, 0);
+  const int frames = static_cast<int>(poses.size()) - 3;
+  EXPECT_LE(sum_angle / matched, 0.01) << "mean E_angle";
+  EXPECT_LE(sum_d / matched, 0.01) << "mean E_d";
+  EXPECT_GE(static_cast<double>(detected) / visible, 0.75) << "detection rate";
+  EXPECT_LE(static_cast<double>(false_detections) / frames, 0.5) << "false planes per frame";
+}
+
+INSTANTIATE_TEST_SUITE_P(NoiseLevels, RoomAtNoise, testing::Values(0.0, 0.5, 1.0));
+
+// One large plane of the given orientation, seen head-on-ish from 2.5 m, three noisy frames:
+// found exactly once, whatever the orientation, pole and border included.
+TEST(PlaneDetector, FindsEveryOrientationOnce)
+{
+  PlaneDetector probe{DetectorParams()};
+  const HoughParameterization& param = probe.parameterization();
+  const Eigen::Vector3d pole = param.pole();
+  const Eigen::Vector3d a = pole.cross(kZ).normalized(), b = pole.cross(a).normalized();
+  std::vector<Eigen::Vector3d> normals = {kX, -kX, kY, -kY, kZ, -kZ, pole, -pole};
+  for (int k = 0; k < 6; ++k)  // exactly on the canonical-sign border
+    normals.push_back(std::cos(k * M_PI / 3) * a + std::sin(k * M_PI / 3) * b);
+  for (double offset : {-0.5, 0.5, 1.5})  // cells to either side of the border
+    normals.push_back((a + offset * param.angleStep() * pole).normalized());
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g;
+  for (int i = 0; i < 16; ++i) normals.push_back(Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized());
+
+  const Eigen::Vector3d eye(0.3, -0.2, 1.1);
+  for (const Eigen::Vector3d& n : normals)
+  {
+    const Eigen::Vector3d centre = eye - 2.5 * n;
+    Scene scene;
+    const Eigen::Vector3d u = n.cross(std::abs(n.z()) < 0.9 ? kZ : kX).normalized(), v = n.cross(u);
+    scene.addRectangle(centre, u, v, 6.0, 6.0, "plane");
+    SceneRenderer renderer(scene);
+    PlaneDetector detector{DetectorParams()};
+    for (int f = 0; f < 3; ++f)
+    {
+      const Eigen::Isometry3d pose = lookAt(eye, centre + 0.4 * f * u + 0.3 * v);
+      feed(detector, renderer.render(pose, kinect(0.5), 7 + f), f);
+    }
+    const double d = -n.dot(centre);
+    EXPECT_EQ(detector.planes().size(), 1u) << "normal " << n.transpose() << describe(detector.planes());
+    EXPECT_EQ(matching(detector.planes(), n, d, 0.01, 0.02).size(), 1u)
+        << "normal " << n.transpose() << " d " << d << describe(detector.planes());
+  }
+}
+
+namespace
+{
+// Two walls at right angles; the camera looks at wall A, then only at wall B.
+struct TwoWalls
+{
+  Scene scene;
+  TwoWalls()
+  {
+    scene.addRectangle({3.0, 0, 1.5}, kY, kZ, 4.0, 1.5, "wall_a");
+    scene.addRectangle({0, 3.0, 1.5}, kX, kZ, 4.0, 1.5, "wall_b");
+  }
+};
+
+// Strength of wall A after `seen` frames of A and `unseen` frames of B.
+std::vector<DetectedPlane> runTwoWalls(const DetectorParams& params, int seen, int unseen, size_t* chunks_before,
+                                       size_t* chunks_after)
+{
+  TwoWalls walls;
+  SceneRenderer renderer(walls.scene);
+  std::vector<RenderedFrame> view_a, view_b;
+  for (int i = 0; i < 3; ++i)
+  {
+    view_a.push_back(renderer.render(lookAt({0, -0.5 + 0.2 * i, 1.0}, {3.0, 0, 1.0}), kinect(0.5), i));
+    view_b.push_back(renderer.render(lookAt({-0.5 + 0.2 * i, -1.0, 1.0}, {0, 3.0, 1.0}), kinect(0.5), 10 + i));
+  }
+  PlaneDetector detector(params);
+  int f = 0;
+  for (int i = 0; i < seen; ++i, ++f) feed(detector, view_a[i % 3], f);
+  if (chunks_before) *chunks_before = detector.memory().global_chunks;
+  for (int i = 0; i < unseen; ++i, ++f) feed(detector, view_b[i % 3], f);
+  if (chunks_after) *chunks_after = detector.memory().global_chunks;
+  return detector.planes();
+}
+}  // namespace
+
+TEST(PlaneDetector, ThinningRemovesAVanishedPlaneAndFreesItsChunks)
+{
+  DetectorParams params;
+  params.thinning_rate = 0.2;
+  size_t before = 0, after = 0;
+  const auto planes = runTwoWalls(params, 8, 45, &before, &after);
+  EXPECT_TRUE(matching(planes, kX, -3.0, 0.01, 0.02).empty()) << describe(planes);
+  EXPECT_EQ(matching(planes, kY, -3.0, 0.01, 0.02).size(), 1u) << describe(planes);
+  EXPECT_GT(before, 0u);
+  // Wall A's chunks were freed; wall B's took their place.
+  EXPECT_LE(after, before + 2) << "chunks of the vanished plane were not freed";
+}
+
+TEST(PlaneDetector, APermanentPlaneStays)
+{
+  DetectorParams params;
+  params.thinning_rate = 0.2;
+  params.permanence_cap = 4.0;
+  const auto planes = runTwoWalls(params, 8, 45, nullptr, nullptr);
+  const auto a = matching(planes, kX, -3.0, 0.01, 0.02);
+  ASSERT_EQ(a.size(), 1u) << describe(planes);
+  EXPECT_NEAR(a[0]->strength, 4.0, 1e-3);
+  EXPECT_EQ(matching(planes, kY, -3.0, 0.01, 0.02).size(), 1u);
+}
+
+TEST(PlaneDetector, AWallSeenFromBothSidesIsOnePlaneWithOneId)
+{
+  Scene scene;
+  scene.addRectangle({0, 0, 1.2}, kY, kZ, 3.0, 1.2, "panel");  // free-standing, x = 0
+  scene.addRectangle({0, 0, 0}, kX, kY, 6.0, 6.0, "floor");
+  SceneRenderer renderer(scene);
+  PlaneDetector detector{DetectorParams()};
+  int f = 0;
+  for (int i = 0; i < 4; ++i, ++f) feed(detector, renderer.render(lookAt({-2.5, 0.3 * i, 1.2}, {0, 0, 1.0}), kinect(1.0), f), f);
+  const auto front = matching(detector.planes(), kX, 0.0, 0.01, 0.02);
+  ASSERT_EQ(front.size(), 1u) << describe(detector.planes());
+  const int id = front[0]->id;
+  const Eigen::Vector3d reported_normal = front[0]->normal;
+  EXPECT_LT(reported_normal.x(), 0.0) << "a new plane's normal faces the sensor";
+  for (int i = 0; i < 4; ++i, ++f) feed(detector, renderer.render(lookAt({2.5, 0.3 * i, 1.2}, {0, 0, 1.0}), kinect(1.0), f), f);
+  const auto both = matching(detector.planes(), kX, 0.0, 0.01, 0.02);
+  ASSERT_EQ(both.size(), 1u) << describe(detector.planes());
+  EXPECT_EQ(both[0]->id, id);
+  EXPECT_GT(both[0]->normal.dot(reported_normal), 0.0) << "the reported side stays stable";
+  EXPECT_GT(both[0]->strength, front[0] == both[0] ? 0.0 : 4.0);
+}
+
+TEST(PlaneDetector, IdsStayStableWhileTheCameraMoves)
+{
+  SceneRenderer renderer(makeOfficeRoom());
+  PlaneDetector detector{DetectorParams()};
+  const auto poses = roomTour(40);
+  int floor_id = -1;
+  for (size_t f = 0; f < 20; ++f)
+  {
+    feed(detector, renderer.render(poses[f], kinect(1.0), f), f);
+    const auto floor = matching(detector.planes(), kZ, 0.0, 0.01, 0.02);
+    if (floor.empty()) continue;
+    ASSERT_EQ(floor.size(), 1u);
+    if (floor_id < 0) floor_id = floor[0]->id;
+    EXPECT_EQ(floor[0]->id, floor_id) << "frame " << f;
+  }
+  EXPECT_GE(floor_id, 0);
+}
+
+// A ramp 10 degrees off the floor, stair treads 15 cm apart and a door 10 cm behind its wall
+// are different planes for a robot: none may be merged into its neighbour.
+TEST(PlaneDetector, KeepsRampStairsAndRecessedDoorApart)
+{
+  SceneRenderer renderer(makeRampStairsHall());
+  PlaneDetector detector{DetectorParams()};
+  const Eigen::Vector3d ramp_normal = Eigen::Vector3d(-std::sin(10 * M_PI / 180), 0, std::cos(10 * M_PI / 180));
+  const double ramp_d = -ramp_normal.dot(Eigen::Vector3d(1.0, -2.2, 0.0));
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < 5; ++i) poses.push_back(lookAt({-0.5 + 0.1 * i, 0.0, 1.3}, {2.0, -2.2, 0.2}));  // ramp
+  for (int i = 0; i < 5; ++i) poses.push_back(lookAt({1.0 + 0.1 * i, 0.2, 1.6}, {3.1, 1.2, 0.2}));   // stairs
+  for (int i = 0; i < 5; ++i) poses.push_back(lookAt({0.2 * i - 0.4, 0.6, 1.2}, {0.0, 3.0, 1.0}));   // door
+  for (size_t f = 0; f < poses.size(); ++f) feed(detector, renderer.render(poses[f], kinect(1.0), 50 + f), f);
+  const auto& planes = detector.planes();
+  EXPECT_EQ(matching(planes, kZ, 0.0, 0.01, 0.02).size(), 1u) << "floor" << describe(planes);
+  EXPECT_EQ(matching(planes, ramp_normal, ramp_d, 0.01, 0.03).size(), 1u) << "ramp" << describe(planes);
+  for (double h : {0.15, 0.30, 0.45})
+    EXPECT_EQ(matching(planes, kZ, -h, 0.02, 0.03).size(), 1u) << "stair tread at " << h << describe(planes);
+  EXPECT_EQ(matching(planes, kY, -3.0, 0.01, 0.02).size(), 1u) << "north wall" << describe(planes);
+  EXPECT_EQ(matching(planes, kY, -3.1, 0.01, 0.02).size(), 1u) << "door" << describe(planes);
+}
+
+TEST(PlaneDetector, CurvedClutterYieldsNoPlane)
+{
+  Scene scene;
+  scene.addRectangle({0, 0, 0}, kX, kY, 8.0, 8.0, "floor");
+  scene.cylinders.push_back({{2.0, -0.6, 0.0}, 0.25, 1.5});
+  scene.cylinders.push_back({{2.5, 0.7, 0.0}, 0.4, 2.0});
+  scene.cylinders.push_back({{1.5, 0.3, 0.0}, 0.12, 1.0});
+  scene.spheres.push_back({{1.6, -0.1, 1.3}, 0.3});
+  scene.spheres.push_back({{3.2, -0.2, 0.5}, 0.5});
+  SceneRenderer renderer(scene);
+  PlaneDetector detector{DetectorParams()};
+  for (int f = 0; f < 20; ++f)
+  {
+    const Eigen::Isometry3d pose = lookAt({0.02 * f, 0.05 * std::sin(0.3 * f), 1.2}, {2.5, 0.0, 0.6});
+    feed(detector, renderer.render(pose, kinect(1.0), 200 + f), f);
+    for (const auto& p : detector.planes())
+      EXPECT_FALSE(matching({p}, kZ, 0.0, 0.02, 0.03).empty()) << "frame " << f << ": plane that is not the floor"
+                                                               << describe({p});
+  }
+  EXPECT_EQ(matching(detector.planes(), kZ, 0.0, 0.01, 0.02).size(), 1u);
+}
+
+TEST(PlaneDetector, BadInputIsRefusedAndLeavesTheMapUntouched)
+{
+  SceneRenderer renderer(makeOfficeRoom());
+  PlaneDetector detector{DetectorParams()};
+  const auto poses = roomTour(40);
+  for (int f = 0; f < 4; ++f) feed(detector, renderer.render(poses[f], kinect(0.5), f), f);
+  const auto before = detector.planes();
+  const size_t chunks = detector.memory().global_chunks;
+  ASSERT_FALSE(before.empty());
+  RenderedFrame frame = renderer.render(poses[4], kinect(0.5), 4);
+
+  std::string error;
+  Eigen::Isometry3d broken = frame.camera_to_world;
+  broken.translation().x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(detector.processFrame(frame.view(), broken, 4, &error));
+  EXPECT_NE(error.find("transform"), std::string::npos) << error;
+  Eigen::Isometry3d scaled = frame.camera_to_world;
+  scaled.linear() *= 2.0;
+  EXPECT_FALSE(detector.processFrame(frame.view(), scaled, 4, &error));
+
+  CloudView tiny = frame.view();
+  tiny.width = 4;
+  tiny.height = 4;
+  EXPECT_FALSE(detector.processFrame(tiny, frame.camera_to_world, 4, &error));
+  EXPECT_NE(error.find("smaller than one normal window"), std::string::npos) << error;
+  EXPECT_FALSE(detector.processFrame(CloudView(), frame.camera_to_world, 4, &error));
+
+  ASSERT_EQ(detector.planes().size(), before.size());
+  for (size_t i = 0; i < before.size(); ++i)
+  {
+    EXPECT_EQ(detector.planes()[i].id, before[i].id);
+    EXPECT_EQ(detector.planes()[i].d, before[i].d);
+    EXPECT_EQ(detector.planes()[i].strength, before[i].strength);
+  }
+  EXPECT_EQ(detector.memory().global_chunks, chunks);
+
+  // An all-NaN / Inf frame is valid input with nothing in it.
+  for (size_t i = 0; i < frame.xyz.size(); ++i)
+    frame.xyz[i] = (i % 2) ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+  EXPECT_TRUE(detector.processFrame(frame.view(), frame.camera_to_world, 5, &error)) << error;
+  EXPECT_EQ(detector.lastStats().samples, 0);
+}
+
+TEST(PlaneDetector, HoughSpaceOfABigRoomStaysUnderOnePercentOfTheDenseArray)
+{
+  // 10 x 10 x 3 m with four walls, floor, ceiling and 16 boxes: 80+ planes.
+  Scene scene;
+  scene.addRectangle({0, 0, 0}, kX, kY, 5.0, 5.0, "floor");
+  scene.addRectangle({0, 0, 3.0}, kX, kY, 5.0, 5.0, "ceiling");
+  scene.addRectangle({5.0, 0, 1.5}, kY, kZ, 5.0, 1.5, "e");
+  scene.addRectangle({-5.0, 0, 1.5}, kY, kZ, 5.0, 1.5, "w");
+  scene.addRectangle({0, 5.0, 1.5}, kX, kZ, 5.0, 1.5, "n");
+  scene.addRectangle({0, -5.0, 1.5}, kX, kZ, 5.0, 1.5, "s");
+  for (int i = 0; i < 16; ++i)
+  {
+    const double a = i * 2 * M_PI / 16;
+    scene.addBox({3.2 * std::cos(a), 3.2 * std::sin(a), 0.2 + 0.05 * i}, {0.4, 0.3, 0.2 + 0.05 * i}, 0.37 * i,
+                 "box" + std::to_string(i));
+  }
+  SceneRenderer renderer(scene);
+  PlaneDetector detector{DetectorParams()};
+  const auto poses = roomTour(48, {0, 0, 1.2}, 1.0);
+  for (size_t f = 0; f < poses.size(); ++f) feed(detector, renderer.render(poses[f], kinect(1.0), f), f);
+  const MemoryReport mem = detector.memory();
+  EXPECT_GE(detector.planes().size(), 12u) << describe(detector.planes());
+  EXPECT_LT(static_cast<double>(mem.global_bytes) / mem.dense_bytes, 0.01)
+      << mem.global_bytes << " bytes of " << mem.dense_bytes;
+  const double dense_1024_cubed = 1024.0 * 1024.0 * 1024.0 * sizeof(float);
+  EXPECT_LT(mem.global_bytes / dense_1024_cubed, 0.01);
+}
