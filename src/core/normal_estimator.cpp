@@ -50,14 +50,20 @@ PointMoments PointMoments::transformed(const Eigen::Isometry3d& transform) const
   return m;
 }
 
+double quantizationStep(double depth)
+{
+  // Kinect disparity: f = 580 px, baseline 0.075 m, 1/8 px steps.
+  return depth * depth / (580.0 * 0.075 * 8.0);
+}
+
 double sensorDepthSigma(double depth, double noise_coefficient)
 {
   if (noise_coefficient <= 0.0) return 0.0;
   const double z_mm = depth * 1000.0;
   const double eq11 = std::max(0.0, 2.6610e-6 * z_mm * z_mm * noise_coefficient * noise_coefficient -
                                         1.0787e-3 * z_mm * noise_coefficient + 2.7011) / 1000.0;
-  // Kinect disparity: f = 580 px, baseline 0.075 m, 1/8 px steps; a uniform step has std step/sqrt(12).
-  const double quantization_step = depth * depth / (580.0 * 0.075 * 8.0);
+  // A uniform step has standard deviation step / sqrt(12).
+  const double quantization_step = quantizationStep(depth);
   return std::sqrt(eq11 * eq11 + quantization_step * quantization_step / 12.0);
 }
 

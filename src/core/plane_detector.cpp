@@ -261,8 +261,9 @@ std::vector<PlaneDetector::Peak> PlaneDetector::extractPeaks(const SparseHoughSp
     if (value < threshold || !isWindowMaximum(space, top)) continue;
     Peak peak;
     peak.hough = param_.fromCell(subVoxelMean(space, top));
-    // Mirrored twins outside the canonical half are the same plane: keep one.
-    if (!param_.isCanonical(peak.hough)) continue;
+    // Mirrored twins beyond the border are the same plane. A peak right on the border may
+    // refine to a hair beyond it on both sides, so allow a cell; the merge joins the twins.
+    if (peak.hough.head<2>().norm() > M_PI / 2 + param_.angleStep()) continue;
     param_.fromHough(peak.hough, peak.normal, peak.d);
     peak.value = value;
     peaks.push_back(peak);
@@ -343,7 +344,14 @@ PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, do
         if (block_mark_[b] == mark_generation_) continue;
         block_mark_[b] = mark_generation_;
         const PointMoments& block = normals_.block(bx, by);
-        if (block.count < 3 || std::abs(n_cam.dot(block.mean()) + d_cam) > params_.support_distance) continue;
+        if (block.count < 3 || (!block_claim_.empty() && block_claim_[b])) continue;
+        const Eigen::Vector3d centroid = block.mean();
+        if (std::abs(n_cam.dot(centroid) + d_cam) > params_.support_distance) continue;
+        // A block straddling an edge keeps its centroid near the plane while a few far points
+        // would dominate the fit's moments: its spread along the normal must look like noise.
+        const double sigma = sensorDepthSigma(centroid.z(), params_.sensor_noise);
+        const double thickness_limit = 0.25 * params_.support_distance * params_.support_distance + 4.0 * sigma * sigma;
+        if (n_cam.dot(block.covariance() * n_cam) > thickness_limit) continue;
         moments.add(block);
         blocks.push_back(b);
       }
@@ -352,20 +360,47 @@ PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, do
 
 bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const
 {
-  // A curved surface (a pillar, a ball) yields windows and even a whole fit within the sensor
-  // noise, but its two halves tilt apart: split the points across each in-plane axis, fit
-  // each half, and require the halves' normals to agree within merge_angle.
+  // A curved surface (a pillar, a ball) yields planar windows and even a whole fit within the
+  // sensor noise; but block centroids, where noise averages out, bend away from the fit.
+  // Each must lie on it as closely as the block's own scatter allows (chi^2 per block).
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(moments.covariance());
+  const Eigen::Vector3d normal = solver.eigenvectors().col(0);
   const Eigen::Vector3d mean = moments.mean();
   const int bx_count = normals_.blocksX();
+  constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
+  double chi2 = 0.0;
+  for (int b : blocks)
+  {
+    const PointMoments& block = normals_.block(b % bx_count, b / bx_count);
+    const double own_variance = std::max(0.0, block.covariance().selfadjointView<Eigen::Upper>().eigenvalues()(0));
+    const Eigen::Vector3d centroid = block.mean();
+    const double distance = normal.dot(centroid - mean);
+    // Disparity quantization moves a whole block together, so it does not average out.
+    const double step = params_.sensor_noise > 0.0 ? quantizationStep(centroid.z()) : 0.0;
+    chi2 += distance * distance / (own_variance / block.count + step * step / 12.0 + kCentroidFloor);
+  }
+  if (!blocks.empty() && chi2 / blocks.size() > 4.0) return false;
+  return true;
+}
+
+bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end) const
+{
+  // A curved strip fits a plane within the noise, but its two halves tilt apart.
+  const int bx_count = normals_.blocksX();
+  PointMoments all;
+  for (size_t i = begin; i < end; ++i) all.add(normals_.block(blocks[i] % bx_count, blocks[i] / bx_count));
+  if (all.count < 3) return true;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(all.covariance());
+  const Eigen::Vector3d mean = all.mean();
   for (int axis = 1; axis <= 2; ++axis)
   {
     const Eigen::Vector3d direction = solver.eigenvectors().col(axis);
     PointMoments halves[2];
-    for (int b : blocks)
+    for (size_t i = begin; i < end; ++i)
     {
-      const PointMoments& block = normals_.block(b % bx_count, b / bx_count);
+      const PointMoments& block = normals_.block(blocks[i] % bx_count, blocks[i] / bx_count);
       halves[direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0].add(block);
     }
     if (halves[0].count < 3 || halves[1].count < 3) continue;
@@ -381,6 +416,44 @@ bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<i
   return true;
 }
 
+PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks)
+{
+  // Two pillars can share a tangent plane: each connected patch of the support must be flat
+  // on its own; curved patches are dropped, tiny ones too (they cannot be tested).
+  constexpr size_t kMinComponentBlocks = 4;
+  const int bx_count = normals_.blocksX(), by_count = normals_.blocksY();
+  member_mark_.resize(static_cast<size_t>(bx_count) * by_count, 0);
+  visit_mark_.resize(member_mark_.size(), 0);
+  ++component_generation_;
+  for (int b : blocks) member_mark_[b] = component_generation_;
+  std::vector<int> kept, component;
+  for (int seed : blocks)
+  {
+    if (visit_mark_[seed] == component_generation_) continue;
+    component.assign(1, seed);
+    visit_mark_[seed] = component_generation_;
+    for (size_t head = 0; head < component.size(); ++head)
+    {
+      const int b = component[head], bx = b % bx_count, by = b / bx_count;
+      const int neighbours[4][2] = {{bx - 1, by}, {bx + 1, by}, {bx, by - 1}, {bx, by + 1}};
+      for (const auto& n : neighbours)
+      {
+        if (n[0] < 0 || n[1] < 0 || n[0] >= bx_count || n[1] >= by_count) continue;
+        const int nb = n[1] * bx_count + n[0];
+        if (member_mark_[nb] != component_generation_ || visit_mark_[nb] == component_generation_) continue;
+        visit_mark_[nb] = component_generation_;
+        component.push_back(nb);
+      }
+    }
+    if (component.size() >= kMinComponentBlocks && halvesAgree(component, 0, component.size()))
+      kept.insert(kept.end(), component.begin(), component.end());
+  }
+  blocks.swap(kept);
+  PointMoments moments;
+  for (int b : blocks) moments.add(normals_.block(b % bx_count, b / bx_count));
+  return moments;
+}
+
 void PlaneDetector::findLocalPeaks()
 {
   std::vector<Eigen::Vector3i> seeds;
@@ -392,32 +465,31 @@ void PlaneDetector::findLocalPeaks()
   std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.value > b.value; });
   if (peaks.size() > kMaxLocalPeaks) peaks.resize(kMaxLocalPeaks);
 
-  std::vector<Eigen::Vector3d> normals;
-  std::vector<double> ds;
-  for (const Peak& p : peaks)
-  {
-    normals.push_back(p.normal);
-    ds.push_back(p.d);
-  }
-  std::vector<std::vector<int>> peak_windows(peaks.size());
-  for (size_t s = 0; s < samples_.size(); ++s)
-  {
-    const int best = bestPlaneFor(samples_[s], normals, ds);
-    if (best >= 0) peak_windows[best].push_back(static_cast<int>(s));
-  }
-
-  // Refine each peak by a least-squares fit to the points of its windows: per-frame planes
-  // that agree to a fraction of a cell keep the global peaks sharp.
+  // Greedy, strongest first: a peak takes the windows that agree with it and no earlier
+  // plane took, is refined by a least-squares fit to their points, and keeps them. Weaker
+  // echoes of the same plane find nothing left; refined per-frame planes that agree to a
+  // fraction of a cell keep the global peaks sharp.
+  std::vector<char> claimed(samples_.size(), 0);
+  block_claim_.assign(static_cast<size_t>(normals_.blocksX()) * normals_.blocksY(), 0);
+  const double cos_limit = std::cos(params_.support_angle);
   std::vector<Peak> supported;
-  std::vector<int> blocks;
-  for (size_t i = 0; i < peaks.size(); ++i)
+  std::vector<int> windows, blocks;
+  for (const Peak& peak : peaks)
   {
-    Eigen::Vector3d normal = peaks[i].normal;
-    double d = peaks[i].d;
+    Eigen::Vector3d normal = peak.normal;
+    double d = peak.d;
     PointMoments moments;
     for (int pass = 0; pass < 2; ++pass)
     {
-      moments = collectPlaneBlocks(normal, d, peak_windows[i], blocks);
+      windows.clear();
+      for (size_t s = 0; s < samples_.size(); ++s)
+      {
+        if (claimed[s] || std::abs(samples_[s].normal.dot(normal)) < cos_limit) continue;
+        if (std::abs(normal.dot(samples_[s].centroid) + d) <= params_.support_distance)
+          windows.push_back(static_cast<int>(s));
+      }
+      collectPlaneBlocks(normal, d, windows, blocks);
+      moments = keepFlatComponents(blocks);
       if (moments.count < std::max(3, params_.min_support)) break;
       const PointMoments world = moments.transformed(camera_to_world_);
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -428,14 +500,17 @@ void PlaneDetector::findLocalPeaks()
       d = -n.dot(world.mean());
     }
     if (moments.count < std::max(3, params_.min_support)) continue;
-    if (!isPlanarFit(moments, blocks)) continue;
-    Peak refined = peaks[i];
+    if (!isPlanarFit(moments, blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;
+    for (int s : windows) claimed[s] = 1;
+    for (int b : blocks) block_claim_[b] = 1;
+    Peak refined = peak;
     refined.normal = normal;
     refined.d = d;
     refined.hough = param_.toHough(normal, d);
     supported.push_back(refined);
   }
   local_peaks_ = mergeSimilar(supported);
+  if (getenv("HPD_DEBUG")) for (auto& p : local_peaks_) printf("   local n=(%.4f %.4f %.4f) d=%.4f value %.1f\n", p.normal.x(), p.normal.y(), p.normal.z(), p.d, p.value);
   stats_.local_peaks = static_cast<int>(local_peaks_.size());
 }
 
@@ -544,6 +619,7 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
     sample_labels_[s] = planes_[best].id;
   }
   block_labels_.assign(static_cast<size_t>(normals_.blocksX()) * normals_.blocksY(), -1);
+  block_claim_.clear();  // the map's planes are distinct: each takes its own windows' blocks
   std::vector<int> blocks;
   for (size_t p = 0; p < planes_.size(); ++p)
   {

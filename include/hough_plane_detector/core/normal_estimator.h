@@ -47,6 +47,8 @@ struct NormalEstimatorConfig
   double sensor_noise = 1.0;
 };
 
+// Depth step of a Kinect's 1/8-pixel disparity at depth z.
+double quantizationStep(double depth);
 // Expected depth noise (eq. 11 plus 1/8-pixel disparity quantization) of a Kinect at depth z.
 double sensorDepthSigma(double depth, double noise_coefficient);
 

@@ -109,8 +109,12 @@ private:
   // Camera-frame moments of the blocks under `windows` that lie on the world plane (normal, d).
   PointMoments collectPlaneBlocks(const Eigen::Vector3d& normal, double d, const std::vector<int>& windows,
                                   std::vector<int>& blocks);
-  // True when the points of a fitted plane scatter no more than the sensor's noise.
+  // True when the block centroids of a fitted plane scatter no more than the sensor's noise.
   bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;
+  // True when the fits of the two halves of blocks[begin, end) agree within merge_angle.
+  bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end) const;
+  // Drops the connected patches of `blocks` that are curved or tiny; moments of the rest.
+  PointMoments keepFlatComponents(std::vector<int>& blocks);
   void addGaussian(SparseHoughSpace& space, const Eigen::Vector3d& hough, float weight, float cap);
 
   DetectorParams params_;
@@ -128,6 +132,10 @@ private:
   std::vector<int> block_labels_;
   std::vector<int> block_mark_;
   int mark_generation_ = 0;
+  std::vector<char> block_claim_;  // blocks taken by an earlier local plane of this frame
+  std::vector<int> member_mark_;
+  std::vector<int> visit_mark_;
+  int component_generation_ = 0;
   std::vector<std::pair<uint64_t, float>> votes_;
   std::vector<std::pair<Eigen::Vector3i, float>> cache_;
   std::vector<Peak> local_peaks_;
