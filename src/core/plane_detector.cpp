@@ -324,7 +324,8 @@ int PlaneDetector::bestPlaneFor(const WindowSample& sample, const std::vector<Ei
 }
 
 PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, double d,
-                                              const std::vector<int>& windows, std::vector<int>& blocks)
+                                              const std::vector<int>& windows, std::vector<int>& blocks,
+                                              bool tight)
 {
   // Blocks covered by the windows, each once, whose points lie on the plane.
   const int k = params_.normal_window / params_.normal_stride;
@@ -346,11 +347,23 @@ PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, do
         const PointMoments& block = normals_.block(bx, by);
         if (block.count < 3 || (!block_claim_.empty() && block_claim_[b])) continue;
         const Eigen::Vector3d centroid = block.mean();
-        if (std::abs(n_cam.dot(centroid) + d_cam) > params_.support_distance) continue;
+        const double sigma = sensorDepthSigma(centroid.z(), params_.sensor_noise);
+        const double residual = std::abs(n_cam.dot(centroid) + d_cam);
+        if (residual > params_.support_distance) continue;
+        // Around a fitted plane, a block centroid may stray by its noise (averaged over the
+        // block; quantization moves a block as a whole) and 1 cm of sensor warp, not more:
+        // this drops surfaces that merely cross the infinite plane along a line.
+        if (tight && params_.sensor_noise > 0.0)
+        {
+          const double step = quantizationStep(centroid.z());
+          const double centroid_sigma = std::sqrt(sigma * sigma / block.count + step * step / 12.0);
+          if (residual > 0.01 + 3.0 * centroid_sigma) continue;
+        }
         // A block straddling an edge keeps its centroid near the plane while a few far points
         // would dominate the fit's moments: its spread along the normal must look like noise.
-        const double sigma = sensorDepthSigma(centroid.z(), params_.sensor_noise);
-        const double thickness_limit = 0.25 * params_.support_distance * params_.support_distance + 4.0 * sigma * sigma;
+        const double thickness_limit = params_.sensor_noise > 0.0
+                                           ? 6.25 * sigma * sigma + 1e-4
+                                           : 0.25 * params_.support_distance * params_.support_distance;
         if (n_cam.dot(block.covariance() * n_cam) > thickness_limit) continue;
         moments.add(block);
         blocks.push_back(b);
@@ -416,6 +429,22 @@ bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, si
   return true;
 }
 
+PointMoments PlaneDetector::weightedMoments(const std::vector<int>& blocks) const
+{
+  // Far points of a Kinect are an order of magnitude noisier than near ones: weight each
+  // block by the inverse variance of its depth so the precise points decide the fit.
+  const int bx_count = normals_.blocksX();
+  PointMoments sum;
+  for (int b : blocks)
+  {
+    PointMoments block = normals_.block(b % bx_count, b / bx_count);
+    const double sigma = sensorDepthSigma(block.mean().z(), params_.sensor_noise);
+    block.scale(1.0 / (sigma * sigma + 1e-6));
+    sum.add(block);
+  }
+  return sum;
+}
+
 PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks)
 {
   // Two pillars can share a tangent plane: each connected patch of the support must be flat
@@ -479,7 +508,7 @@ void PlaneDetector::findLocalPeaks()
     Eigen::Vector3d normal = peak.normal;
     double d = peak.d;
     PointMoments moments;
-    for (int pass = 0; pass < 2; ++pass)
+    for (int pass = 0; pass < 3; ++pass)
     {
       windows.clear();
       for (size_t s = 0; s < samples_.size(); ++s)
@@ -488,10 +517,10 @@ void PlaneDetector::findLocalPeaks()
         if (std::abs(normal.dot(samples_[s].centroid) + d) <= params_.support_distance)
           windows.push_back(static_cast<int>(s));
       }
-      collectPlaneBlocks(normal, d, windows, blocks);
+      collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
       moments = keepFlatComponents(blocks);
       if (moments.count < std::max(3, params_.min_support)) break;
-      const PointMoments world = moments.transformed(camera_to_world_);
+      const PointMoments world = weightedMoments(blocks).transformed(camera_to_world_);
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
       solver.computeDirect(world.covariance());
       Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
@@ -500,16 +529,29 @@ void PlaneDetector::findLocalPeaks()
       d = -n.dot(world.mean());
     }
     if (moments.count < std::max(3, params_.min_support)) continue;
-    if (!isPlanarFit(moments, blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;
+    if (getenv("HPD_DEBUG")) printf("  candidate n=(%.3f %.3f %.3f) d=%.3f count %.0f blocks %zu planar %d halves %d\n", normal.x(), normal.y(), normal.z(), d, moments.count, blocks.size(), (int)isPlanarFit(weightedMoments(blocks), blocks), (int)halvesAgree(blocks, 0, blocks.size()));
+    if (getenv("HPD_BLOCKS") && std::abs(normal.x() + 0.044) < 0.003) for (int b : blocks) { Eigen::Vector3d c = camera_to_world_ * normals_.block(b % normals_.blocksX(), b / normals_.blocksX()).mean(); printf("    blk (%.2f %.2f %.3f)\n", c.x(), c.y(), c.z()); }
+    if (!isPlanarFit(weightedMoments(blocks), blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;
+    // Claim everything within support_distance, not just the tight fit, so that leftovers
+    // around an accepted plane cannot pose as a slightly tilted second one.
     for (int s : windows) claimed[s] = 1;
     for (int b : blocks) block_claim_[b] = 1;
+    collectPlaneBlocks(normal, d, windows, blocks, false);
+    for (int b : blocks) block_claim_[b] = 1;
+    if (getenv("HPD_RAMP") && std::abs(normal.z() - 0.985) < 0.01 && std::abs(normal.x()+0.17) < 0.01) {
+      const Eigen::Vector3d tn(-0.17364817766, 0, 0.98480775301); const double td = 0.17364817766;
+      int hist[9] = {0};
+      for (int b : blocks) { Eigen::Vector3d c = camera_to_world_ * normals_.block(b % normals_.blocksX(), b / normals_.blocksX()).mean(); double r = tn.dot(c) + td; int bin = std::max(0, std::min(8, (int)std::floor(r / 0.01) + 4)); hist[bin]++; if (std::abs(r) > 0.03) printf("   off block (%.2f %.2f %.2f) r=%.3f\n", c.x(), c.y(), c.z(), r); }
+      printf("ramp fit blocks %zu residual hist (cm bins -4..4):", blocks.size()); for (int h : hist) printf(" %d", h); printf("\n");
+    }
     Peak refined = peak;
     refined.normal = normal;
     refined.d = d;
     refined.hough = param_.toHough(normal, d);
     supported.push_back(refined);
   }
-  local_peaks_ = mergeSimilar(supported);
+  // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
+  local_peaks_ = supported;
   if (getenv("HPD_DEBUG")) for (auto& p : local_peaks_) printf("   local n=(%.4f %.4f %.4f) d=%.4f value %.1f\n", p.normal.x(), p.normal.y(), p.normal.z(), p.d, p.value);
   stats_.local_peaks = static_cast<int>(local_peaks_.size());
 }

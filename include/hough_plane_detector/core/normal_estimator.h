@@ -21,6 +21,8 @@ struct PointMoments
 
   void add(const PointMoments& o);
   void subtract(const PointMoments& o);
+  // Weights every point by w (mean and covariance unchanged, count becomes a weight sum).
+  void scale(double w);
   Eigen::Vector3d mean() const { return sum / count; }
   Eigen::Matrix3d covariance() const;
   // The same points moved by a rigid transform.

@@ -107,12 +107,15 @@ private:
   int bestPlaneFor(const WindowSample& sample, const std::vector<Eigen::Vector3d>& normals,
                    const std::vector<double>& ds) const;
   // Camera-frame moments of the blocks under `windows` that lie on the world plane (normal, d).
+  // `tight` (around a fitted plane) also drops blocks farther off than their own noise allows.
   PointMoments collectPlaneBlocks(const Eigen::Vector3d& normal, double d, const std::vector<int>& windows,
-                                  std::vector<int>& blocks);
+                                  std::vector<int>& blocks, bool tight = false);
   // True when the block centroids of a fitted plane scatter no more than the sensor's noise.
   bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;
   // True when the fits of the two halves of blocks[begin, end) agree within merge_angle.
   bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end) const;
+  // Moments of the blocks, each weighted by the inverse variance of the sensor at its depth.
+  PointMoments weightedMoments(const std::vector<int>& blocks) const;
   // Drops the connected patches of `blocks` that are curved or tiny; moments of the rest.
   PointMoments keepFlatComponents(std::vector<int>& blocks);
   void addGaussian(SparseHoughSpace& space, const Eigen::Vector3d& hough, float weight, float cap);
