@@ -110,7 +110,7 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
           std::memcpy(&x, p + cloud.x_offset, sizeof(float));
           std::memcpy(&y, p + cloud.y_offset, sizeof(float));
           std::memcpy(&z, p + cloud.z_offset, sizeof(float));
-          if (!(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) continue;
+          if (!std::isfinite(x + y + z)) continue;  // NaN or Inf in any coordinate
           if (b.n == 0)
           {
             b.rx = x; b.ry = y; b.rz = z;

@@ -1,8 +1,6 @@
 #include "hough_plane_detector/core/plane_detector.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -323,6 +321,33 @@ int PlaneDetector::bestPlaneFor(const WindowSample& sample, const std::vector<Ei
   return best;
 }
 
+void PlaneDetector::describeBlocks()
+{
+  // Per block, once per frame: centroid, covariance and the noise limits the tests use.
+  const int count = normals_.blocksX() * normals_.blocksY();
+  block_info_.resize(count);
+  for (int b = 0; b < count; ++b)
+  {
+    const PointMoments& block = normals_.block(b % normals_.blocksX(), b / normals_.blocksX());
+    BlockInfo& info = block_info_[b];
+    info.valid = block.count >= 3;
+    if (!info.valid) continue;
+    info.centroid = block.mean();
+    info.covariance = block.covariance();
+    const double sigma = sensorDepthSigma(info.centroid.z(), params_.sensor_noise);
+    const double step = params_.sensor_noise > 0.0 ? quantizationStep(info.centroid.z()) : 0.0;
+    // Quantization moves a block as a whole, so it does not average out over the block.
+    info.centroid_variance = sigma * sigma / block.count + step * step / 12.0;
+    // Around a fitted plane a centroid may stray by its noise and 1 cm of sensor warp.
+    info.tight_residual = params_.sensor_noise > 0.0 ? 0.01 + 3.0 * std::sqrt(info.centroid_variance)
+                                                     : params_.support_distance;
+    info.thickness_limit = params_.sensor_noise > 0.0
+                               ? 6.25 * sigma * sigma + 1e-4
+                               : 0.25 * params_.support_distance * params_.support_distance;
+    info.fit_weight = 1.0 / (sigma * sigma + 1e-6);
+  }
+}
+
 PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, double d,
                                               const std::vector<int>& windows, std::vector<int>& blocks,
                                               bool tight)
@@ -344,28 +369,16 @@ PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, do
         const int b = by * bx_count + bx;
         if (block_mark_[b] == mark_generation_) continue;
         block_mark_[b] = mark_generation_;
-        const PointMoments& block = normals_.block(bx, by);
-        if (block.count < 3 || (!block_claim_.empty() && block_claim_[b])) continue;
-        const Eigen::Vector3d centroid = block.mean();
-        const double sigma = sensorDepthSigma(centroid.z(), params_.sensor_noise);
-        const double residual = std::abs(n_cam.dot(centroid) + d_cam);
-        if (residual > params_.support_distance) continue;
-        // Around a fitted plane, a block centroid may stray by its noise (averaged over the
-        // block; quantization moves a block as a whole) and 1 cm of sensor warp, not more:
-        // this drops surfaces that merely cross the infinite plane along a line.
-        if (tight && params_.sensor_noise > 0.0)
-        {
-          const double step = quantizationStep(centroid.z());
-          const double centroid_sigma = std::sqrt(sigma * sigma / block.count + step * step / 12.0);
-          if (residual > 0.01 + 3.0 * centroid_sigma) continue;
-        }
+        const BlockInfo& info = block_info_[b];
+        if (!info.valid || (!block_claim_.empty() && block_claim_[b])) continue;
+        const double residual = std::abs(n_cam.dot(info.centroid) + d_cam);
+        // Tight: drops surfaces that merely cross the infinite plane along a line.
+        if (residual > (tight ? std::min(params_.support_distance, info.tight_residual) : params_.support_distance))
+          continue;
         // A block straddling an edge keeps its centroid near the plane while a few far points
         // would dominate the fit's moments: its spread along the normal must look like noise.
-        const double thickness_limit = params_.sensor_noise > 0.0
-                                           ? 6.25 * sigma * sigma + 1e-4
-                                           : 0.25 * params_.support_distance * params_.support_distance;
-        if (n_cam.dot(block.covariance() * n_cam) > thickness_limit) continue;
-        moments.add(block);
+        if (n_cam.dot(info.covariance * n_cam) > info.thickness_limit) continue;
+        moments.add(normals_.block(bx, by));
         blocks.push_back(b);
       }
   return moments;
@@ -385,13 +398,13 @@ bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<i
   double chi2 = 0.0;
   for (int b : blocks)
   {
-    const PointMoments& block = normals_.block(b % bx_count, b / bx_count);
-    const double own_variance = std::max(0.0, block.covariance().selfadjointView<Eigen::Upper>().eigenvalues()(0));
-    const Eigen::Vector3d centroid = block.mean();
-    const double distance = normal.dot(centroid - mean);
-    // Disparity quantization moves a whole block together, so it does not average out.
-    const double step = params_.sensor_noise > 0.0 ? quantizationStep(centroid.z()) : 0.0;
-    chi2 += distance * distance / (own_variance / block.count + step * step / 12.0 + kCentroidFloor);
+    const BlockInfo& info = block_info_[b];
+    const double count = normals_.block(b % bx_count, b / bx_count).count;
+    // The block's own scatter along the plane normal: noise if it lies on the plane.
+    const double own_variance = std::max(0.0, normal.dot(info.covariance * normal));
+    const double step = params_.sensor_noise > 0.0 ? quantizationStep(info.centroid.z()) : 0.0;
+    const double distance = normal.dot(info.centroid - mean);
+    chi2 += distance * distance / (own_variance / count + step * step / 12.0 + kCentroidFloor);
   }
   if (!blocks.empty() && chi2 / blocks.size() > 4.0) return false;
   return true;
@@ -438,8 +451,7 @@ PointMoments PlaneDetector::weightedMoments(const std::vector<int>& blocks) cons
   for (int b : blocks)
   {
     PointMoments block = normals_.block(b % bx_count, b / bx_count);
-    const double sigma = sensorDepthSigma(block.mean().z(), params_.sensor_noise);
-    block.scale(1.0 / (sigma * sigma + 1e-6));
+    block.scale(block_info_[b].fit_weight);
     sum.add(block);
   }
   return sum;
@@ -485,9 +497,14 @@ PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks)
 
 void PlaneDetector::findLocalPeaks()
 {
+  describeBlocks();
+  // A peak above the threshold has voted cells next to it blurred to well over half of it
+  // (the kernel falls to 0.6 one cell away); climbing from the rest only finds weak peaks.
   std::vector<Eigen::Vector3i> seeds;
   seeds.reserve(cache_.size());
-  for (const auto& entry : cache_) seeds.push_back(entry.first);
+  const float seed_floor = static_cast<float>(0.5 * params_.local_threshold);
+  for (const auto& entry : cache_)
+    if (local_.value(entry.first.x(), entry.first.y(), entry.first.z()) >= seed_floor) seeds.push_back(entry.first);
   std::vector<Peak> peaks = extractPeaks(local_, seeds, params_.local_threshold);
   // The strongest peaks are enough; a frame holds far fewer real planes than this.
   constexpr size_t kMaxLocalPeaks = 64;
@@ -499,6 +516,8 @@ void PlaneDetector::findLocalPeaks()
   // echoes of the same plane find nothing left; refined per-frame planes that agree to a
   // fraction of a cell keep the global peaks sharp.
   std::vector<char> claimed(samples_.size(), 0);
+  const double overlap = static_cast<double>(params_.normal_stride * params_.normal_stride) /
+                         (params_.normal_window * params_.normal_window);
   block_claim_.assign(static_cast<size_t>(normals_.blocksX()) * normals_.blocksY(), 0);
   const double cos_limit = std::cos(params_.support_angle);
   std::vector<Peak> supported;
@@ -511,11 +530,21 @@ void PlaneDetector::findLocalPeaks()
     for (int pass = 0; pass < 3; ++pass)
     {
       windows.clear();
+      double window_points = 0.0;
       for (size_t s = 0; s < samples_.size(); ++s)
       {
         if (claimed[s] || std::abs(samples_[s].normal.dot(normal)) < cos_limit) continue;
         if (std::abs(normal.dot(samples_[s].centroid) + d) <= params_.support_distance)
+        {
           windows.push_back(static_cast<int>(s));
+          window_points += samples_[s].count * overlap;
+        }
+      }
+      // Overlapping windows count their points about once each: too few, no fit needed.
+      if (window_points < params_.min_support)
+      {
+        moments = PointMoments();
+        break;
       }
       collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
       moments = keepFlatComponents(blocks);
@@ -529,8 +558,6 @@ void PlaneDetector::findLocalPeaks()
       d = -n.dot(world.mean());
     }
     if (moments.count < std::max(3, params_.min_support)) continue;
-    if (getenv("HPD_DEBUG")) printf("  candidate n=(%.3f %.3f %.3f) d=%.3f count %.0f blocks %zu planar %d halves %d\n", normal.x(), normal.y(), normal.z(), d, moments.count, blocks.size(), (int)isPlanarFit(weightedMoments(blocks), blocks), (int)halvesAgree(blocks, 0, blocks.size()));
-    if (getenv("HPD_BLOCKS") && std::abs(normal.x() + 0.044) < 0.003) for (int b : blocks) { Eigen::Vector3d c = camera_to_world_ * normals_.block(b % normals_.blocksX(), b / normals_.blocksX()).mean(); printf("    blk (%.2f %.2f %.3f)\n", c.x(), c.y(), c.z()); }
     if (!isPlanarFit(weightedMoments(blocks), blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;
     // Claim everything within support_distance, not just the tight fit, so that leftovers
     // around an accepted plane cannot pose as a slightly tilted second one.
@@ -538,12 +565,6 @@ void PlaneDetector::findLocalPeaks()
     for (int b : blocks) block_claim_[b] = 1;
     collectPlaneBlocks(normal, d, windows, blocks, false);
     for (int b : blocks) block_claim_[b] = 1;
-    if (getenv("HPD_RAMP") && std::abs(normal.z() - 0.985) < 0.01 && std::abs(normal.x()+0.17) < 0.01) {
-      const Eigen::Vector3d tn(-0.17364817766, 0, 0.98480775301); const double td = 0.17364817766;
-      int hist[9] = {0};
-      for (int b : blocks) { Eigen::Vector3d c = camera_to_world_ * normals_.block(b % normals_.blocksX(), b / normals_.blocksX()).mean(); double r = tn.dot(c) + td; int bin = std::max(0, std::min(8, (int)std::floor(r / 0.01) + 4)); hist[bin]++; if (std::abs(r) > 0.03) printf("   off block (%.2f %.2f %.2f) r=%.3f\n", c.x(), c.y(), c.z(), r); }
-      printf("ramp fit blocks %zu residual hist (cm bins -4..4):", blocks.size()); for (int h : hist) printf(" %d", h); printf("\n");
-    }
     Peak refined = peak;
     refined.normal = normal;
     refined.d = d;
@@ -552,7 +573,6 @@ void PlaneDetector::findLocalPeaks()
   }
   // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
   local_peaks_ = supported;
-  if (getenv("HPD_DEBUG")) for (auto& p : local_peaks_) printf("   local n=(%.4f %.4f %.4f) d=%.4f value %.1f\n", p.normal.x(), p.normal.y(), p.normal.z(), p.d, p.value);
   stats_.local_peaks = static_cast<int>(local_peaks_.size());
 }
 

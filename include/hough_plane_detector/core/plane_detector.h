@@ -92,7 +92,19 @@ private:
     double value;
   };
 
+  struct BlockInfo
+  {
+    bool valid = false;
+    Eigen::Vector3d centroid;
+    Eigen::Matrix3d covariance;
+    double centroid_variance = 0;  // expected scatter of the centroid about its true plane
+    double tight_residual = 0;     // farthest a centroid may lie from a fitted plane
+    double thickness_limit = 0;    // largest spread along the plane normal
+    double fit_weight = 1;         // inverse depth-noise variance
+  };
+
   void vote();
+  void describeBlocks();
   void blurCache();
   void findLocalPeaks();
   void updateGlobal(const Eigen::Vector3d& camera_position, double stamp);
@@ -133,6 +145,7 @@ private:
   std::vector<WindowSample> samples_;
   std::vector<int> sample_labels_;
   std::vector<int> block_labels_;
+  std::vector<BlockInfo> block_info_;
   std::vector<int> block_mark_;
   int mark_generation_ = 0;
   std::vector<char> block_claim_;  // blocks taken by an earlier local plane of this frame
