@@ -143,7 +143,7 @@ bool BagFrameSource::next(BagFrame& frame)
 {
   while (impl_->it != impl_->view->end())
   {
-    const rosbag::MessageInstance& m = *impl_->it;
+    const rosbag::MessageInstance m = *impl_->it;  // a copy: the iterator owns what it points to
     ++impl_->it;
     frame = BagFrame();
     frame.cloud = m.instantiate<sensor_msgs::PointCloud2>();
