@@ -90,13 +90,31 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
   struct BlockAccumulator
   {
     float rx, ry, rz;
-    int n;
+    float n;
     float sx, sy, sz, xx, xy, xz, yy, yz, zz;
   };
   std::vector<BlockAccumulator> row_blocks(blocks_x_);
   for (int by = 0; by < blocks_y_; ++by)
   {
-    for (auto& b : row_blocks) b = BlockAccumulator{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    // Reference point of each block: its first valid point (found before the main pass, so
+    // the per-point loop below has no data-dependent branch).
+    for (int bx = 0; bx < blocks_x_; ++bx)
+    {
+      BlockAccumulator& b = row_blocks[bx];
+      b = BlockAccumulator{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+      bool found = false;
+      for (int v = by * s; v < (by + 1) * s && !found; ++v)
+        for (int u = bx * s; u < (bx + 1) * s && !found; ++u)
+        {
+          float x, y, z;
+          cloud.point(u, v, x, y, z);
+          if (std::isfinite(x + y + z))
+          {
+            b.rx = x; b.ry = y; b.rz = z;
+            found = true;
+          }
+        }
+    }
     for (int v = by * s; v < (by + 1) * s; ++v)
     {
       const uint8_t* row = cloud.data + static_cast<size_t>(v) * cloud.row_step;
@@ -104,30 +122,30 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
       {
         BlockAccumulator& b = row_blocks[bx];
         const uint8_t* p = row + static_cast<size_t>(bx * s) * cloud.point_step;
+        float n = 0, sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
         for (int i = 0; i < s; ++i, p += cloud.point_step)
         {
           float x, y, z;
           std::memcpy(&x, p + cloud.x_offset, sizeof(float));
           std::memcpy(&y, p + cloud.y_offset, sizeof(float));
           std::memcpy(&z, p + cloud.z_offset, sizeof(float));
-          if (!std::isfinite(x + y + z)) continue;  // NaN or Inf in any coordinate
-          if (b.n == 0)
-          {
-            b.rx = x; b.ry = y; b.rz = z;
-          }
-          const float qx = x - b.rx, qy = y - b.ry, qz = z - b.rz;
-          ++b.n;
-          b.sx += qx; b.sy += qy; b.sz += qz;
-          b.xx += qx * qx; b.xy += qx * qy; b.xz += qx * qz;
-          b.yy += qy * qy; b.yz += qy * qz; b.zz += qz * qz;
+          const bool valid = std::isfinite(x + y + z);  // NaN or Inf in any coordinate
+          const float qx = valid ? x - b.rx : 0.0f, qy = valid ? y - b.ry : 0.0f, qz = valid ? z - b.rz : 0.0f;
+          n += valid ? 1.0f : 0.0f;
+          sx += qx; sy += qy; sz += qz;
+          xx += qx * qx; xy += qx * qy; xz += qx * qz;
+          yy += qy * qy; yz += qy * qz; zz += qz * qz;
         }
+        b.n += n;
+        b.sx += sx; b.sy += sy; b.sz += sz;
+        b.xx += xx; b.xy += xy; b.xz += xz; b.yy += yy; b.yz += yz; b.zz += zz;
       }
     }
     for (int bx = 0; bx < blocks_x_; ++bx)
     {
       const BlockAccumulator& b = row_blocks[bx];
       PointMoments& m = blocks_[static_cast<size_t>(by) * blocks_x_ + bx];
-      if (b.n == 0) continue;
+      if (b.n == 0.0f) continue;
       // Shift the relative sums back to the origin: S = Q + r q^T + q r^T + n r r^T.
       const double n = b.n, rx = b.rx, ry = b.ry, rz = b.rz;
       m.count = n;
