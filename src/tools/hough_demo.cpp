@@ -98,7 +98,6 @@ int main(int argc, char** argv)
     return v.empty() ? 0.0 : s / v.size();
   };
   std::sort(ms.begin(), ms.end());
-  std::printf("stage medians (ms): see benchmark_detector for the per-stage figures\n");
   const MemoryReport mem = detector.memory();
   std::printf("\nafter frame %d: E_angle %.4f rad, E_d %.4f m, detected %d of %d visible planes (%.1f %%), "
               "%.3f false planes per frame\n",
