@@ -83,6 +83,16 @@ public:
   // Forgets every plane and empties the global space.
   void reset();
 
+  // The whole persistent state (global space, planes, next id) as bytes: versioned, with the
+  // grid it was built on and a checksum.
+  std::string serializeMap() const;
+  // Replaces the state by a serialized one; on any problem (foreign or truncated data, wrong
+  // version or checksum, another grid) returns false with `error` set and changes nothing.
+  bool deserializeMap(const std::string& bytes, std::string* error);
+  // File versions: saving writes FILE.tmp and renames it, so a crash never leaves half a map.
+  bool saveMap(const std::string& path, std::string* error) const;
+  bool loadMap(const std::string& path, std::string* error);
+
 private:
   struct Peak
   {

@@ -1,0 +1,217 @@
+// Saving and loading the detector's persistent map.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "hough_plane_detector/core/plane_detector.h"
+
+namespace hough_plane_detector
+{
+
+namespace
+{
+constexpr char kMagic[8] = {'H', 'P', 'D', 'M', 'A', 'P', '\n', '\0'};
+constexpr uint32_t kVersion = 1;
+
+uint64_t fnv1a(const char* data, size_t size)
+{
+  uint64_t hash = 1469598103934665603ull;
+  for (size_t i = 0; i < size; ++i)
+  {
+    hash ^= static_cast<unsigned char>(data[i]);
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
+
+class Writer
+{
+public:
+  template <class T>
+  void put(const T& value)
+  {
+    bytes.append(reinterpret_cast<const char*>(&value), sizeof(T));
+  }
+  void putBytes(const void* data, size_t size) { bytes.append(static_cast<const char*>(data), size); }
+  std::string bytes;
+};
+
+class Reader
+{
+public:
+  Reader(const std::string& bytes, size_t end) : bytes_(bytes), end_(end) {}
+  template <class T>
+  bool get(T& value)
+  {
+    return getBytes(&value, sizeof(T));
+  }
+  bool getBytes(void* out, size_t size)
+  {
+    if (pos_ + size > end_) return false;
+    std::memcpy(out, bytes_.data() + pos_, size);
+    pos_ += size;
+    return true;
+  }
+  size_t position() const { return pos_; }
+
+private:
+  const std::string& bytes_;
+  size_t end_;
+  size_t pos_ = 0;
+};
+}  // namespace
+
+std::string PlaneDetector::serializeMap() const
+{
+  Writer w;
+  w.putBytes(kMagic, sizeof(kMagic));
+  w.put(kVersion);
+  w.put(param_.angleStep());
+  w.put(param_.dStep());
+  w.put(param_.maxDistance());
+  w.put(static_cast<int32_t>(param_.sizeAngle()));
+  w.put(static_cast<int32_t>(param_.sizeD()));
+  w.put(static_cast<int32_t>(next_id_));
+  w.put(static_cast<uint32_t>(planes_.size()));
+  for (const DetectedPlane& p : planes_)
+  {
+    w.put(static_cast<int32_t>(p.id));
+    for (int i = 0; i < 3; ++i) w.put(p.normal(i));
+    w.put(p.d);
+    w.put(p.strength);
+    w.put(static_cast<int32_t>(p.support));
+    w.put(p.first_seen);
+    w.put(p.last_seen);
+    for (int i = 0; i < 3; ++i) w.put(p.hough(i));
+  }
+  const auto& chunks = global_.allocatedChunkIndices();
+  w.put(static_cast<uint32_t>(chunks.size()));
+  for (int index : chunks)
+  {
+    w.put(static_cast<int32_t>(index));
+    w.putBytes(global_.chunkData(index), sizeof(float) * SparseHoughSpace::kChunkCells);
+  }
+  w.put(fnv1a(w.bytes.data(), w.bytes.size()));
+  return w.bytes;
+}
+
+bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
+{
+  auto fail = [error](const std::string& what) {
+    if (error) *error = what;
+    return false;
+  };
+  if (bytes.size() < sizeof(kMagic) + sizeof(uint32_t) + sizeof(uint64_t) ||
+      std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
+    return fail("not a hough_plane_detector map (no HPDMAP header)");
+  Reader r(bytes, bytes.size() - sizeof(uint64_t));
+  char magic[sizeof(kMagic)];
+  uint32_t version = 0;
+  r.getBytes(magic, sizeof(magic));
+  r.get(version);
+  if (version != kVersion)
+    return fail("map format version " + std::to_string(version) + " is not the supported version " +
+                std::to_string(kVersion));
+  uint64_t stored_checksum;
+  std::memcpy(&stored_checksum, bytes.data() + bytes.size() - sizeof(uint64_t), sizeof(uint64_t));
+  if (stored_checksum != fnv1a(bytes.data(), bytes.size() - sizeof(uint64_t)))
+    return fail("map checksum does not match: the file is truncated or corrupted");
+
+  double angle_step, d_step, max_distance;
+  int32_t size_angle, size_d, next_id;
+  uint32_t plane_count;
+  if (!r.get(angle_step) || !r.get(d_step) || !r.get(max_distance) || !r.get(size_angle) || !r.get(size_d) ||
+      !r.get(next_id) || !r.get(plane_count))
+    return fail("map header is truncated");
+  if (std::abs(angle_step - param_.angleStep()) > 1e-12 || std::abs(d_step - param_.dStep()) > 1e-12 ||
+      std::abs(max_distance - param_.maxDistance()) > 1e-12 || size_angle != param_.sizeAngle() ||
+      size_d != param_.sizeD())
+  {
+    std::ostringstream what;
+    what << "map was built with angle_step " << angle_step << ", d_step " << d_step << ", max_distance "
+         << max_distance << " (" << size_angle << " x " << size_angle << " x " << size_d
+         << " cells); the detector has angle_step " << param_.angleStep() << ", d_step " << param_.dStep()
+         << ", max_distance " << param_.maxDistance() << ", blur and peak windows as configured";
+    return fail(what.str());
+  }
+  std::vector<DetectedPlane> planes(plane_count);
+  for (DetectedPlane& p : planes)
+  {
+    int32_t id, support;
+    bool ok = r.get(id);
+    for (int i = 0; i < 3; ++i) ok = ok && r.get(p.normal(i));
+    ok = ok && r.get(p.d) && r.get(p.strength) && r.get(support) && r.get(p.first_seen) && r.get(p.last_seen);
+    for (int i = 0; i < 3; ++i) ok = ok && r.get(p.hough(i));
+    if (!ok) return fail("map planes are truncated");
+    p.id = id;
+    p.support = support;
+  }
+  uint32_t chunk_count;
+  if (!r.get(chunk_count)) return fail("map chunk list is truncated");
+  const size_t top_level = global_.topLevelCount();
+  std::vector<std::pair<int32_t, std::vector<float>>> chunks(chunk_count);
+  for (auto& chunk : chunks)
+  {
+    chunk.second.resize(SparseHoughSpace::kChunkCells);
+    if (!r.get(chunk.first) || !r.getBytes(chunk.second.data(), sizeof(float) * SparseHoughSpace::kChunkCells))
+      return fail("map chunks are truncated");
+    if (chunk.first < 0 || static_cast<size_t>(chunk.first) >= top_level)
+      return fail("map chunk index " + std::to_string(chunk.first) + " is outside the Hough space");
+  }
+  if (r.position() != bytes.size() - sizeof(uint64_t)) return fail("map has trailing bytes");
+
+  // Everything read and checked: only now replace the state.
+  global_.clear();
+  for (const auto& chunk : chunks)
+    std::memcpy(global_.allocateChunk(chunk.first), chunk.second.data(), sizeof(float) * SparseHoughSpace::kChunkCells);
+  planes_ = planes;
+  next_id_ = next_id;
+  samples_.clear();
+  sample_labels_.clear();
+  block_labels_.clear();
+  return true;
+}
+
+bool PlaneDetector::saveMap(const std::string& path, std::string* error) const
+{
+  const std::string bytes = serializeMap();
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out || !out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())) || !out.flush())
+    {
+      if (error) *error = "cannot write " + tmp;
+      std::remove(tmp.c_str());
+      return false;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+  {
+    if (error) *error = "cannot rename " + tmp + " to " + path;
+    std::remove(tmp.c_str());
+    return false;
+  }
+  return true;
+}
+
+bool PlaneDetector::loadMap(const std::string& path, std::string* error)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+  {
+    if (error) *error = "cannot open " + path;
+    return false;
+  }
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string why;
+  if (!deserializeMap(bytes, &why))
+  {
+    if (error) *error = path + ": " + why;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace hough_plane_detector

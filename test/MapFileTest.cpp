@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/core/scene_renderer.h"
+
+using namespace hough_plane_detector;
+
+namespace
+{
+// A detector that has seen a few frames of the office.
+void warmUp(PlaneDetector& detector, int frames)
+{
+  SceneRenderer renderer(makeOfficeRoom());
+  const auto poses = roomTour(40);
+  KinectNoise noise;
+  for (int f = 0; f < frames; ++f)
+  {
+    const RenderedFrame frame = renderer.render(poses[f], noise, 70 + f);
+    ASSERT_TRUE(detector.processFrame(frame.view(), frame.camera_to_world, f));
+  }
+}
+
+std::string readFile(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void writeFile(const std::string& path, const std::string& bytes)
+{
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+void expectSameMap(const PlaneDetector& a, const PlaneDetector& b)
+{
+  ASSERT_EQ(a.planes().size(), b.planes().size());
+  for (size_t i = 0; i < a.planes().size(); ++i)
+  {
+    EXPECT_EQ(a.planes()[i].id, b.planes()[i].id);
+    EXPECT_EQ(a.planes()[i].normal, b.planes()[i].normal);
+    EXPECT_EQ(a.planes()[i].d, b.planes()[i].d);
+    EXPECT_EQ(a.planes()[i].strength, b.planes()[i].strength);
+  }
+  EXPECT_EQ(a.globalSpace().chunkCount(), b.globalSpace().chunkCount());
+  size_t cells = 0;
+  a.globalSpace().forEachNonZero([&](int x, int y, int z, float v) {
+    ++cells;
+    EXPECT_EQ(b.globalSpace().value(x, y, z), v);
+  });
+  EXPECT_GT(cells, 0u);
+}
+}  // namespace
+
+TEST(MapFile, SaveAndLoadRestoreTheMapExactlyAndDetectionGoesOn)
+{
+  PlaneDetector original{DetectorParams()};
+  warmUp(original, 6);
+  ASSERT_FALSE(original.planes().empty());
+  const std::string path = testing::TempDir() + "hpd_map_roundtrip.map";
+  std::string error;
+  ASSERT_TRUE(original.saveMap(path, &error)) << error;
+  EXPECT_FALSE(std::ifstream(path + ".tmp").good()) << "the temporary file was renamed away";
+
+  PlaneDetector restored{DetectorParams()};
+  ASSERT_TRUE(restored.loadMap(path, &error)) << error;
+  expectSameMap(original, restored);
+
+  // Both go on identically from the same next frame, ids included.
+  SceneRenderer renderer(makeOfficeRoom());
+  const RenderedFrame frame = renderer.render(roomTour(40)[6], KinectNoise(), 99);
+  ASSERT_TRUE(original.processFrame(frame.view(), frame.camera_to_world, 6));
+  ASSERT_TRUE(restored.processFrame(frame.view(), frame.camera_to_world, 6));
+  expectSameMap(original, restored);
+}
+
+TEST(MapFile, RefusesBrokenOrForeignFilesAndKeepsTheCurrentMap)
+{
+  PlaneDetector source{DetectorParams()};
+  warmUp(source, 4);
+  const std::string good = source.serializeMap();
+
+  PlaneDetector target{DetectorParams()};
+  warmUp(target, 2);
+  const auto planes_before = target.planes();
+  const size_t chunks_before = target.globalSpace().chunkCount();
+  auto expectUntouched = [&]() {
+    ASSERT_EQ(target.planes().size(), planes_before.size());
+    for (size_t i = 0; i < planes_before.size(); ++i) EXPECT_EQ(target.planes()[i].d, planes_before[i].d);
+    EXPECT_EQ(target.globalSpace().chunkCount(), chunks_before);
+  };
+
+  std::string error;
+  EXPECT_FALSE(target.loadMap(testing::TempDir() + "does_not_exist.map", &error));
+  EXPECT_NE(error.find("cannot open"), std::string::npos) << error;
+
+  EXPECT_FALSE(target.deserializeMap("just some text file\n", &error));
+  EXPECT_NE(error.find("not a hough_plane_detector map"), std::string::npos) << error;
+
+  EXPECT_FALSE(target.deserializeMap(good.substr(0, good.size() / 2), &error));
+  EXPECT_NE(error.find("checksum"), std::string::npos) << error;
+
+  std::string corrupted = good;
+  corrupted[good.size() / 2] ^= 0x40;
+  EXPECT_FALSE(target.deserializeMap(corrupted, &error));
+  EXPECT_NE(error.find("checksum"), std::string::npos) << error;
+
+  std::string other_version = good;
+  other_version[8] = 7;  // the version follows the 8-byte magic
+  EXPECT_FALSE(target.deserializeMap(other_version, &error));
+  EXPECT_NE(error.find("version 7"), std::string::npos) << error;
+
+  DetectorParams coarse;
+  coarse.resolution = 512;
+  PlaneDetector coarse_detector(coarse);
+  EXPECT_FALSE(coarse_detector.deserializeMap(good, &error));
+  EXPECT_NE(error.find("angle_step"), std::string::npos) << error;
+
+  const std::string path = testing::TempDir() + "hpd_map_truncated.map";
+  writeFile(path, good.substr(0, 100));
+  EXPECT_FALSE(target.loadMap(path, &error));
+  EXPECT_NE(error.find(path), std::string::npos) << "names the file: " << error;
+  expectUntouched();
+
+  EXPECT_TRUE(target.deserializeMap(good, &error)) << error;
+  EXPECT_EQ(target.planes().size(), source.planes().size());
+}
+
+TEST(MapFile, SavingToAnUnwritablePlaceFailsCleanly)
+{
+  PlaneDetector detector{DetectorParams()};
+  std::string error;
+  EXPECT_FALSE(detector.saveMap("/nonexistent-dir/x.map", &error));
+  EXPECT_NE(error.find("cannot write"), std::string::npos) << error;
+}
