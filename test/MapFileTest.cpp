@@ -135,3 +135,35 @@ TEST(MapFile, SavingToAnUnwritablePlaceFailsCleanly)
   EXPECT_FALSE(detector.saveMap("/nonexistent-dir/x.map", &error));
   EXPECT_NE(error.find("cannot write"), std::string::npos) << error;
 }
+
+TEST(PlaneExtent, HullCoversTheSeenPartOfTheFloorAndFades)
+{
+  PlaneDetector detector{DetectorParams()};
+  warmUp(detector, 6);
+  const DetectedPlane* floor = nullptr;
+  for (const auto& p : detector.planes())
+    if (std::abs(p.normal.z()) > 0.99 && std::abs(p.d) < 0.02) floor = &p;
+  ASSERT_NE(floor, nullptr);
+  const auto hull = detector.hull(*floor);
+  ASSERT_GE(hull.size(), 3u);
+  // Every hull vertex lies on the floor, inside the 6 x 5 m room (plus one cell).
+  for (const auto& p : hull)
+  {
+    EXPECT_NEAR(p.z(), 0.0, 0.03);
+    EXPECT_LE(std::abs(p.x()), 3.06);
+    EXPECT_LE(std::abs(p.y()), 2.56);
+  }
+  // Counter-clockwise about the reported normal.
+  Eigen::Vector3d area = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < hull.size(); ++i) area += hull[i].cross(hull[(i + 1) % hull.size()]);
+  EXPECT_GT(area.dot(floor->normal), 0.5) << "the patch covers at least 0.25 m^2, facing the normal";
+
+  PlaneExtent extent;
+  extent.add(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(1.02, 2.01, 0.0));
+  extent.add(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(1.02, 2.01, 0.0));
+  extent.add(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(-0.5, 0.3, 0.0));
+  EXPECT_EQ(extent.cellCount(), 2u);
+  extent.decay(1.5f);  // the cell seen once goes, the one seen twice stays
+  EXPECT_EQ(extent.cellCount(), 1u);
+  EXPECT_EQ(extent.hull(Eigen::Vector3d::UnitZ(), 0.0).size(), 4u);  // one 5 cm square
+}

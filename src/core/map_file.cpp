@@ -1,4 +1,5 @@
 // Saving and loading the detector's persistent map.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -93,6 +94,22 @@ std::string PlaneDetector::serializeMap() const
     w.put(static_cast<int32_t>(index));
     w.putBytes(global_.chunkData(index), sizeof(float) * SparseHoughSpace::kChunkCells);
   }
+  w.put(static_cast<uint32_t>(extents_.size()));
+  std::vector<int> ids;
+  for (const auto& e : extents_) ids.push_back(e.first);
+  std::sort(ids.begin(), ids.end());
+  for (int id : ids)
+  {
+    const auto cells = extents_.at(id).cells();
+    w.put(static_cast<int32_t>(id));
+    w.put(static_cast<uint32_t>(cells.size()));
+    for (const auto& cell : cells)
+    {
+      w.put(cell.first.first);
+      w.put(cell.first.second);
+      w.put(cell.second);
+    }
+  }
   w.put(fnv1a(w.bytes.data(), w.bytes.size()));
   return w.bytes;
 }
@@ -160,6 +177,23 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
     if (chunk.first < 0 || static_cast<size_t>(chunk.first) >= top_level)
       return fail("map chunk index " + std::to_string(chunk.first) + " is outside the Hough space");
   }
+  uint32_t extent_count;
+  if (!r.get(extent_count)) return fail("map extents are truncated");
+  std::unordered_map<int, PlaneExtent> extents;
+  for (uint32_t i = 0; i < extent_count; ++i)
+  {
+    int32_t id;
+    uint32_t cell_count;
+    if (!r.get(id) || !r.get(cell_count) || cell_count > PlaneExtent::kMaxCells) return fail("map extents are truncated");
+    PlaneExtent& extent = extents[id];
+    for (uint32_t c = 0; c < cell_count; ++c)
+    {
+      int32_t x, y;
+      float weight;
+      if (!r.get(x) || !r.get(y) || !r.get(weight)) return fail("map extents are truncated");
+      extent.setCell(x, y, weight);
+    }
+  }
   if (r.position() != bytes.size() - sizeof(uint64_t)) return fail("map has trailing bytes");
 
   // Everything read and checked: only now replace the state.
@@ -167,6 +201,7 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
   for (const auto& chunk : chunks)
     std::memcpy(global_.allocateChunk(chunk.first), chunk.second.data(), sizeof(float) * SparseHoughSpace::kChunkCells);
   planes_ = planes;
+  extents_.swap(extents);
   next_id_ = next_id;
   samples_.clear();
   sample_labels_.clear();

@@ -58,6 +58,7 @@ PlaneDetector::PlaneDetector(const DetectorParams& params)
 
 void PlaneDetector::reset()
 {
+  extents_.clear();
   global_.clear();
   local_.clear();
   planes_.clear();
@@ -691,6 +692,95 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   }
   for (DetectedPlane& plane : planes_)
     if (plane.support >= params_.min_support) plane.last_seen = stamp;
+
+  // Extents: this frame's labelled blocks mark their cells; every cell fades like the space.
+  std::unordered_map<int, PlaneExtent> extents;
+  for (const DetectedPlane& plane : planes_)
+  {
+    auto it = extents_.find(plane.id);
+    if (it != extents_.end()) extents[plane.id] = std::move(it->second);
+    extents[plane.id].decay(static_cast<float>(params_.thinning_rate));
+  }
+  extents_.swap(extents);
+  std::unordered_map<int, const DetectedPlane*> by_id;
+  for (const DetectedPlane& plane : planes_) by_id[plane.id] = &plane;
+  for (size_t b = 0; b < block_labels_.size(); ++b)
+  {
+    if (block_labels_[b] < 0) continue;
+    const DetectedPlane& plane = *by_id[block_labels_[b]];
+    const PointMoments& block = normals_.block(static_cast<int>(b) % normals_.blocksX(), static_cast<int>(b) / normals_.blocksX());
+    extents_[plane.id].add(plane.normal, plane.d, camera_to_world_ * block.mean());
+  }
+}
+
+}  // namespace hough_plane_detector
+
+namespace hough_plane_detector
+{
+
+const PlaneExtent* PlaneDetector::extent(int id) const
+{
+  const auto it = extents_.find(id);
+  return it == extents_.end() ? nullptr : &it->second;
+}
+
+std::vector<Eigen::Vector3d> PlaneDetector::hull(const DetectedPlane& plane) const
+{
+  const PlaneExtent* e = extent(plane.id);
+  return e ? e->hull(plane.normal, plane.d) : std::vector<Eigen::Vector3d>();
+}
+
+void PlaneDetector::labelPixels(const CloudView& cloud, std::vector<int>& labels) const
+{
+  labels.assign(cloud.size(), -1);
+  const int s = params_.normal_stride, bx_count = normals_.blocksX();
+  if (block_labels_.empty() || cloud.width / s != bx_count || cloud.height / s != normals_.blocksY()) return;
+  std::unordered_map<int, std::pair<Eigen::Vector3d, double>> camera_planes;
+  for (const DetectedPlane& plane : planes_)
+  {
+    const Eigen::Vector3d n = camera_to_world_.linear().transpose() * plane.normal;
+    camera_planes[plane.id] = {n, plane.d + plane.normal.dot(camera_to_world_.translation())};
+  }
+  for (size_t b = 0; b < block_labels_.size(); ++b)
+  {
+    if (block_labels_[b] < 0) continue;
+    const auto& plane = camera_planes[block_labels_[b]];
+    const int bx = static_cast<int>(b) % bx_count, by = static_cast<int>(b) / bx_count;
+    for (int v = by * s; v < (by + 1) * s; ++v)
+      for (int u = bx * s; u < (bx + 1) * s; ++u)
+      {
+        float x, y, z;
+        cloud.point(u, v, x, y, z);
+        if (std::isfinite(x + y + z) &&
+            std::abs(plane.first.dot(Eigen::Vector3d(x, y, z)) + plane.second) <= params_.support_distance)
+          labels[static_cast<size_t>(v) * cloud.width + u] = block_labels_[b];
+      }
+  }
+}
+
+bool PlaneDetector::sameGrid(const DetectorParams& a, const DetectorParams& b)
+{
+  return a.effectiveAngleStep() == b.effectiveAngleStep() && a.effectiveDStep() == b.effectiveDStep() &&
+         a.max_distance == b.max_distance && a.blur_kernel_size == b.blur_kernel_size && a.peak_window == b.peak_window;
+}
+
+bool PlaneDetector::updateParams(const DetectorParams& params, std::string* why)
+{
+  const std::string problem = params.validate();
+  if (!problem.empty())
+  {
+    if (why) *why = problem;
+    return false;
+  }
+  if (!sameGrid(params, params_))
+  {
+    if (why) *why = "the Hough grid changes";
+    return false;
+  }
+  params_ = params;
+  for (int i = -blur_radius_; i <= blur_radius_; ++i)
+    blur_kernel_[i + blur_radius_] = static_cast<float>(std::exp(-0.5 * i * i / (params_.blur_sigma * params_.blur_sigma)));
+  return true;
 }
 
 }  // namespace hough_plane_detector

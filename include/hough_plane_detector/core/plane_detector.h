@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <unordered_map>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "hough_plane_detector/core/detector_params.h"
 #include "hough_plane_detector/core/hough_parameterization.h"
 #include "hough_plane_detector/core/normal_estimator.h"
+#include "hough_plane_detector/core/plane_extent.h"
 #include "hough_plane_detector/core/sparse_hough_space.h"
 
 namespace hough_plane_detector
@@ -79,6 +81,19 @@ public:
   // normalEstimator().blocksX() x blocksY(); a block is labelled when its points lie on the plane.
   const std::vector<int>& lastBlockLabels() const { return block_labels_; }
   const NormalEstimator& normalEstimator() const { return normals_; }
+  // Plane id of every pixel of the last frame (-1: none): pixels of a labelled block that lie
+  // within support_distance of its plane. `cloud` must be the last frame's cloud.
+  void labelPixels(const CloudView& cloud, std::vector<int>& labels) const;
+  // Where the plane has been seen (nullptr for an unknown id).
+  const PlaneExtent* extent(int id) const;
+  // Convex hull of the plane's extent in the world frame (empty when it has none).
+  std::vector<Eigen::Vector3d> hull(const DetectedPlane& plane) const;
+
+  // Parameters that keep the Hough grid (everything but resolution, angle_step, d_step,
+  // max_distance, blur_kernel_size, peak_window) change in place; returns false, changing
+  // nothing, when the new ones need a new detector (and an empty map) or are invalid.
+  bool updateParams(const DetectorParams& params, std::string* why);
+  static bool sameGrid(const DetectorParams& a, const DetectorParams& b);
 
   // Forgets every plane and empties the global space.
   void reset();
@@ -166,6 +181,7 @@ private:
   std::vector<std::pair<Eigen::Vector3i, float>> cache_;
   std::vector<Peak> local_peaks_;
   std::vector<DetectedPlane> planes_;
+  std::unordered_map<int, PlaneExtent> extents_;
   int next_id_ = 0;
   StageTimings timings_;
   FrameStats stats_;
