@@ -14,9 +14,12 @@ all: build
 deps:
 	@scripts/install_deps.sh
 
+# The workspace's copy of the package links every top-level entry but build/ itself: a link to
+# the whole tree would make roslaunch's file search recurse through build/ws/src forever.
 build: deps
-	@mkdir -p $(WS)/src
-	@ln -sfn $(CURDIR) $(WS)/src/$(PKG)
+	@if [ -L $(WS)/src/$(PKG) ]; then rm $(WS)/src/$(PKG); fi
+	@mkdir -p $(WS)/src/$(PKG)
+	@for f in $$(ls -A | grep -vxE 'build|\.git'); do ln -sfn $(CURDIR)/$$f $(WS)/src/$(PKG)/$$f; done
 	catkin_make -C $(WS) -DCMAKE_BUILD_TYPE=Release
 
 test: build

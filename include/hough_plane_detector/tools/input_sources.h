@@ -11,12 +11,12 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include "hough_plane_detector/core/cloud_view.h"
+#include "hough_plane_detector/ros/point_cloud2_layout.h"
 
 namespace hough_plane_detector
 {
 
 PointBufferLayout layoutOf(const pcl::PCLPointCloud2& cloud);
-PointBufferLayout layoutOf(const sensor_msgs::PointCloud2& cloud);
 
 // Loads a PCD file; false with `error` naming the file and the problem.
 bool loadPcd(const std::string& path, pcl::PCLPointCloud2& cloud, std::string* error);

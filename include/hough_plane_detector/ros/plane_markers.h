@@ -1,0 +1,28 @@
+// RViz markers and the segmented cloud for the plane map.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/ColorRGBA.h>
+#include <visualization_msgs/Marker.h>
+
+#include "hough_plane_detector/core/plane_detector.h"
+
+namespace hough_plane_detector
+{
+
+// A stable, well-spread colour per plane id (golden-ratio hues).
+std_msgs::ColorRGBA colourForId(int id, float alpha);
+// DELETEALL, sent first in every array so that no marker of a vanished plane stays.
+visualization_msgs::Marker deleteAllMarker(const std_msgs::Header& header);
+// Per plane: filled patch (TRIANGLE_LIST, ns "patches"), outline (LINE_STRIP, "outlines"),
+// normal (ARROW, "normals") and id label (TEXT_VIEW_FACING, "labels"); marker id = plane id.
+void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane,
+                        const std::vector<Eigen::Vector3d>& hull, std::vector<visualization_msgs::Marker>& markers);
+// x y z of the frame plus rgb and label (plane id, -1 for none) per point.
+void fillSegmentedCloud(const std_msgs::Header& header, const CloudView& view, const std::vector<int>& labels,
+                        sensor_msgs::PointCloud2& out);
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,371 @@
+// The ROS face of the detector: organized clouds in, the persistent plane map out.
+#include <cmath>
+#include <deque>
+#include <memory>
+#include <mutex>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
+#include <message_filters/subscriber.h>
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "hough_plane_detector/HoughPlaneDetectorConfig.h"
+#include "hough_plane_detector/LoadMap.h"
+#include "hough_plane_detector/PlaneArray.h"
+#include "hough_plane_detector/SaveMap.h"
+#include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/ros/plane_markers.h"
+#include "hough_plane_detector/ros/point_cloud2_layout.h"
+
+namespace hough_plane_detector
+{
+
+namespace
+{
+DetectorParams toParams(const HoughPlaneDetectorConfig& c)
+{
+  DetectorParams p;
+  p.resolution = c.resolution;
+  p.angle_step = c.angle_step;
+  p.d_step = c.d_step;
+  p.max_distance = c.max_distance;
+  p.blur_sigma = c.blur_sigma;
+  p.blur_kernel_size = c.blur_kernel_size;
+  p.peak_window = c.peak_window;
+  p.local_threshold = c.local_threshold;
+  p.min_support = c.min_support;
+  p.global_threshold = c.global_threshold;
+  p.thinning_rate = c.thinning_rate;
+  p.permanence_cap = c.permanence_cap;
+  p.merge_angle = c.merge_angle;
+  p.merge_distance = c.merge_distance;
+  p.normal_window = c.normal_window;
+  p.normal_stride = c.normal_stride;
+  p.min_valid_fraction = c.min_valid_fraction;
+  p.max_curvature = c.max_curvature;
+  p.sensor_noise = c.sensor_noise;
+  p.support_distance = c.support_distance;
+  p.support_angle = c.support_angle;
+  return p;
+}
+
+HoughPlaneDetectorConfig toConfig(const DetectorParams& p)
+{
+  HoughPlaneDetectorConfig c;
+  c.resolution = p.resolution;
+  c.angle_step = p.angle_step;
+  c.d_step = p.d_step;
+  c.max_distance = p.max_distance;
+  c.blur_sigma = p.blur_sigma;
+  c.blur_kernel_size = p.blur_kernel_size;
+  c.peak_window = p.peak_window;
+  c.local_threshold = p.local_threshold;
+  c.min_support = p.min_support;
+  c.global_threshold = p.global_threshold;
+  c.thinning_rate = p.thinning_rate;
+  c.permanence_cap = p.permanence_cap;
+  c.merge_angle = p.merge_angle;
+  c.merge_distance = p.merge_distance;
+  c.normal_window = p.normal_window;
+  c.normal_stride = p.normal_stride;
+  c.min_valid_fraction = p.min_valid_fraction;
+  c.max_curvature = p.max_curvature;
+  c.sensor_noise = p.sensor_noise;
+  c.support_distance = p.support_distance;
+  c.support_angle = p.support_angle;
+  return c;
+}
+}  // namespace
+
+class PlaneDetectorNodelet : public nodelet::Nodelet
+{
+public:
+  ~PlaneDetectorNodelet() override
+  {
+    // Stop what calls back into this object before its members go (DEBIAN-ROS pitfall 12).
+    diagnostics_timer_.stop();
+    tf_filter_.reset();
+    subscriber_.reset();
+  }
+
+private:
+  void onInit() override
+  {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& private_nh = getPrivateNodeHandle();
+    private_nh.param<std::string>("world_frame", world_frame_, "odom");
+    private_nh.param("latch", latch_, false);
+    int queue_size;
+    private_nh.param("queue_size", queue_size, 2);
+    double tf_tolerance;
+    private_nh.param("transform_tolerance", tf_tolerance, 0.1);
+    int concurrency_level;
+    private_nh.param("concurrency_level", concurrency_level, 1);
+
+    // Every detector parameter from the private handle, defaults from the core.
+    HoughPlaneDetectorConfig config = toConfig(DetectorParams());
+    config.__fromServer__(private_nh);
+    params_ = toParams(config);
+    std::string problem = params_.validate();
+    if (!problem.empty())
+    {
+      NODELET_ERROR("Invalid detector parameters (%s); using the defaults.", problem.c_str());
+      params_ = DetectorParams();
+    }
+    detector_.reset(new PlaneDetector(params_));
+
+    tf_buffer_.reset(new tf2_ros::Buffer);
+    tf_listener_.reset(new tf2_ros::TransformListener(*tf_buffer_));
+
+    planes_pub_ = private_nh.advertise<PlaneArray>("planes", 2, latch_);
+    markers_pub_ = private_nh.advertise<visualization_msgs::MarkerArray>("markers", 2, latch_);
+    segmented_pub_ = private_nh.advertise<sensor_msgs::PointCloud2>("segmented_cloud", 2);
+    reset_srv_ = private_nh.advertiseService("reset", &PlaneDetectorNodelet::resetService, this);
+    save_srv_ = private_nh.advertiseService("save_map", &PlaneDetectorNodelet::saveMapService, this);
+    load_srv_ = private_nh.advertiseService("load_map", &PlaneDetectorNodelet::loadMapService, this);
+
+    reconfigure_server_.reset(new dynamic_reconfigure::Server<HoughPlaneDetectorConfig>(config_mutex_, private_nh));
+    {
+      boost::recursive_mutex::scoped_lock lock(config_mutex_);
+      reconfigure_server_->updateConfig(toConfig(params_));
+    }
+    reconfigure_server_->setCallback(boost::bind(&PlaneDetectorNodelet::reconfigure, this, boost::placeholders::_1, boost::placeholders::_2));
+
+    diagnostics_.reset(new diagnostic_updater::Updater(nh, private_nh, getName()));
+    diagnostics_->setHardwareID("none");
+    diagnostics_->add("plane map", this, &PlaneDetectorNodelet::diagnose);
+    diagnostics_timer_ = private_nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_->update(); });
+
+    // A multi-threaded handle lets services answer while a frame is being processed.
+    ros::NodeHandle& cloud_nh = concurrency_level > 1 ? getMTNodeHandle() : nh;
+    subscriber_.reset(new message_filters::Subscriber<sensor_msgs::PointCloud2>(cloud_nh, "cloud_in", queue_size));
+    tf_filter_.reset(new tf2_ros::MessageFilter<sensor_msgs::PointCloud2>(*subscriber_, *tf_buffer_, world_frame_,
+                                                                          queue_size, cloud_nh));
+    tf_filter_->setTolerance(ros::Duration(tf_tolerance));
+    tf_filter_->registerCallback(boost::bind(&PlaneDetectorNodelet::cloudCallback, this, boost::placeholders::_1));
+    tf_filter_->registerFailureCallback(boost::bind(&PlaneDetectorNodelet::failureCallback, this, boost::placeholders::_1, boost::placeholders::_2));
+    NODELET_INFO("Detecting planes in %s (world frame %s), resolution %d.", subscriber_->getTopic().c_str(),
+                 world_frame_.c_str(), params_.resolution);
+  }
+
+  void failureCallback(const sensor_msgs::PointCloud2ConstPtr& cloud,
+                       tf2_ros::filter_failure_reasons::FilterFailureReason reason)
+  {
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    ++frames_dropped_;
+    NODELET_WARN_THROTTLE(5.0, "Cloud skipped: no transform from '%s' to '%s' at %.3f (%s).",
+                          cloud->header.frame_id.c_str(), world_frame_.c_str(), cloud->header.stamp.toSec(),
+                          reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame_id" :
+                          reason == tf2_ros::filter_failure_reasons::OutTheBack ? "older than the tf buffer" :
+                                                                                 "not available in time");
+  }
+
+  void cloudCallback(const sensor_msgs::PointCloud2ConstPtr& cloud)
+  {
+    Eigen::Isometry3d camera_to_world;
+    try
+    {
+      camera_to_world = tf2::transformToEigen(
+          tf_buffer_->lookupTransform(world_frame_, cloud->header.frame_id, cloud->header.stamp));
+    }
+    catch (const tf2::TransformException& e)
+    {
+      std::lock_guard<std::mutex> lock(map_mutex_);
+      ++frames_dropped_;
+      NODELET_WARN_THROTTLE(5.0, "Cloud skipped: %s", e.what());
+      return;
+    }
+    // The message is read in place (float32 x/y/z) and never modified.
+    CloudView view;
+    std::vector<float> converted;
+    std::string error = makeCloudView(layoutOf(*cloud), view, converted);
+
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    arrivals_.push_back(ros::WallTime::now());
+    while (arrivals_.size() > 30) arrivals_.pop_front();
+    if (error.empty()) detector_->processFrame(view, camera_to_world, cloud->header.stamp.toSec(), &error);
+    if (!error.empty())
+    {
+      ++frames_rejected_;
+      NODELET_ERROR_THROTTLE(5.0, "Cloud from '%s' refused: %s", cloud->header.frame_id.c_str(), error.c_str());
+      return;
+    }
+    ++frames_processed_;
+    last_ms_ = detector_->lastTimings().total_ms;
+    last_stamp_ = cloud->header.stamp;
+    publishMap();
+    if (segmented_pub_.getNumSubscribers() > 0) publishSegmented(*cloud, view);
+  }
+
+  // Caller holds map_mutex_.
+  void publishMap()
+  {
+    std_msgs::Header header;
+    header.frame_id = world_frame_;
+    header.stamp = last_stamp_;
+    PlaneArray::Ptr planes(new PlaneArray);
+    planes->header = header;
+    visualization_msgs::MarkerArray::Ptr markers(new visualization_msgs::MarkerArray);
+    markers->markers.push_back(deleteAllMarker(header));
+    for (const DetectedPlane& p : detector_->planes())
+    {
+      const std::vector<Eigen::Vector3d> hull = detector_->hull(p);
+      Plane msg;
+      msg.id = p.id;
+      msg.coef.coef = {p.normal.x(), p.normal.y(), p.normal.z(), p.d};
+      msg.normal.x = p.normal.x();
+      msg.normal.y = p.normal.y();
+      msg.normal.z = p.normal.z();
+      msg.d = p.d;
+      msg.strength = p.strength;
+      msg.support = static_cast<uint32_t>(p.support);
+      msg.first_seen.fromSec(p.first_seen);
+      msg.last_seen.fromSec(p.last_seen);
+      for (const auto& v : hull)
+      {
+        geometry_msgs::Point32 q;
+        q.x = v.x();
+        q.y = v.y();
+        q.z = v.z();
+        msg.hull.points.push_back(q);
+      }
+      planes->planes.push_back(msg);
+      appendPlaneMarkers(header, p, hull, markers->markers);
+    }
+    planes_pub_.publish(planes);
+    markers_pub_.publish(markers);
+  }
+
+  void publishSegmented(const sensor_msgs::PointCloud2& cloud, const CloudView& view)
+  {
+    std::vector<int> labels;
+    detector_->labelPixels(view, labels);
+    sensor_msgs::PointCloud2::Ptr out(new sensor_msgs::PointCloud2);
+    fillSegmentedCloud(cloud.header, view, labels, *out);
+    segmented_pub_.publish(out);
+  }
+
+  void reconfigure(HoughPlaneDetectorConfig& config, uint32_t /*level*/)
+  {
+    const DetectorParams requested = toParams(config);
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    const std::string problem = requested.validate();
+    if (!problem.empty())
+    {
+      NODELET_ERROR("Reconfigure refused: %s; keeping the current parameters.", problem.c_str());
+      config = toConfig(params_);
+      return;
+    }
+    if (PlaneDetector::sameGrid(requested, params_))
+    {
+      std::string why;
+      detector_->updateParams(requested, &why);
+    }
+    else
+    {
+      NODELET_WARN("Hough grid reconfigured (resolution %d, angle_step %g, d_step %g): the map starts empty.",
+                   requested.resolution, requested.effectiveAngleStep(), requested.effectiveDStep());
+      detector_.reset(new PlaneDetector(requested));
+      publishMap();
+    }
+    params_ = requested;
+  }
+
+  bool resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
+  {
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    detector_->reset();
+    publishMap();  // an empty array and a DELETEALL: no stale markers
+    NODELET_INFO("Plane map reset.");
+    return true;
+  }
+
+  bool saveMapService(SaveMap::Request& req, SaveMap::Response& res)
+  {
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    std::string error;
+    res.success = detector_->saveMap(req.path, &error);
+    res.message = res.success ? "saved " + std::to_string(detector_->planes().size()) + " planes to " + req.path : error;
+    if (res.success)
+      NODELET_INFO("%s", res.message.c_str());
+    else
+      NODELET_ERROR("save_map failed: %s", res.message.c_str());
+    return true;
+  }
+
+  bool loadMapService(LoadMap::Request& req, LoadMap::Response& res)
+  {
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    std::string error;
+    res.success = detector_->loadMap(req.path, &error);
+    res.message = res.success ? "loaded " + std::to_string(detector_->planes().size()) + " planes from " + req.path
+                              : error + "; the current map is kept";
+    if (res.success)
+      NODELET_INFO("%s", res.message.c_str());
+    else
+      NODELET_ERROR("load_map refused: %s", res.message.c_str());
+    if (res.success) publishMap();
+    return true;
+  }
+
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
+  {
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    const MemoryReport memory = detector_->memory();
+    double rate = 0.0;
+    if (arrivals_.size() >= 2)
+      rate = (arrivals_.size() - 1) / std::max(1e-6, (arrivals_.back() - arrivals_.front()).toSec());
+    if (frames_processed_ == 0)
+      status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no cloud processed yet");
+    else if (frames_dropped_ + frames_rejected_ > 0)
+      status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "some clouds were skipped");
+    else
+      status.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
+    status.add("input rate (Hz)", rate);
+    status.add("ms per frame (last)", last_ms_);
+    status.add("frames processed", frames_processed_);
+    status.add("frames skipped (no transform)", frames_dropped_);
+    status.add("frames refused (bad cloud)", frames_rejected_);
+    status.add("planes", detector_->planes().size());
+    status.add("Hough space MB", memory.global_bytes / 1e6);
+    status.add("Hough space % of dense", 100.0 * memory.global_bytes / std::max<size_t>(1, memory.dense_bytes));
+    status.add("Hough chunks", memory.global_chunks);
+    const HoughParameterization& grid = detector_->parameterization();
+    status.addf("Hough grid", "resolution %d: %d x %d x %d cells", params_.resolution, grid.sizeAngle(), grid.sizeAngle(),
+                grid.sizeD());
+  }
+
+  std::mutex map_mutex_;  // guards detector_, params_ and the counters on every path
+  std::unique_ptr<PlaneDetector> detector_;
+  DetectorParams params_;
+  std::string world_frame_;
+  bool latch_ = false;
+  ros::Time last_stamp_;
+  double last_ms_ = 0.0;
+  int frames_processed_ = 0, frames_dropped_ = 0, frames_rejected_ = 0;
+  std::deque<ros::WallTime> arrivals_;
+
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<message_filters::Subscriber<sensor_msgs::PointCloud2>> subscriber_;
+  std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> tf_filter_;
+  ros::Publisher planes_pub_, markers_pub_, segmented_pub_;
+  ros::ServiceServer reset_srv_, save_srv_, load_srv_;
+  boost::recursive_mutex config_mutex_;  // dynamic_reconfigure's own; the map has map_mutex_
+  std::unique_ptr<dynamic_reconfigure::Server<HoughPlaneDetectorConfig>> reconfigure_server_;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
+  ros::Timer diagnostics_timer_;
+};
+
+}  // namespace hough_plane_detector
+
+PLUGINLIB_EXPORT_CLASS(hough_plane_detector::PlaneDetectorNodelet, nodelet::Nodelet)

@@ -1,0 +1,144 @@
+#include "hough_plane_detector/ros/plane_markers.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+namespace hough_plane_detector
+{
+
+std_msgs::ColorRGBA colourForId(int id, float alpha)
+{
+  const double hue = std::fmod(0.13 + 0.618033988749895 * id, 1.0) * 6.0;
+  const double x = 1.0 - std::abs(std::fmod(hue, 2.0) - 1.0);
+  double r = 0, g = 0, b = 0;
+  switch (static_cast<int>(hue))
+  {
+    case 0: r = 1; g = x; break;
+    case 1: r = x; g = 1; break;
+    case 2: g = 1; b = x; break;
+    case 3: g = x; b = 1; break;
+    case 4: r = x; b = 1; break;
+    default: r = 1; b = x; break;
+  }
+  std_msgs::ColorRGBA c;
+  c.r = static_cast<float>(0.15 + 0.85 * r);
+  c.g = static_cast<float>(0.15 + 0.85 * g);
+  c.b = static_cast<float>(0.15 + 0.85 * b);
+  c.a = alpha;
+  return c;
+}
+
+visualization_msgs::Marker deleteAllMarker(const std_msgs::Header& header)
+{
+  visualization_msgs::Marker m;
+  m.header = header;
+  m.action = visualization_msgs::Marker::DELETEALL;
+  return m;
+}
+
+namespace
+{
+geometry_msgs::Point toPoint(const Eigen::Vector3d& v)
+{
+  geometry_msgs::Point p;
+  p.x = v.x();
+  p.y = v.y();
+  p.z = v.z();
+  return p;
+}
+
+visualization_msgs::Marker baseMarker(const std_msgs::Header& header, const char* ns, int id, int type)
+{
+  visualization_msgs::Marker m;
+  m.header = header;
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = 1.0;
+  return m;
+}
+}  // namespace
+
+void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane,
+                        const std::vector<Eigen::Vector3d>& hull, std::vector<visualization_msgs::Marker>& markers)
+{
+  if (hull.size() < 3) return;  // not seen enough yet to have an extent
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& v : hull) centre += v;
+  centre /= static_cast<double>(hull.size());
+
+  visualization_msgs::Marker patch = baseMarker(header, "patches", plane.id, visualization_msgs::Marker::TRIANGLE_LIST);
+  patch.color = colourForId(plane.id, 0.45f);
+  for (size_t i = 0; i < hull.size(); ++i)  // the hull is convex: a fan around its centre
+  {
+    patch.points.push_back(toPoint(centre));
+    patch.points.push_back(toPoint(hull[i]));
+    patch.points.push_back(toPoint(hull[(i + 1) % hull.size()]));
+  }
+  markers.push_back(patch);
+
+  visualization_msgs::Marker outline = baseMarker(header, "outlines", plane.id, visualization_msgs::Marker::LINE_STRIP);
+  outline.scale.x = 0.02;
+  outline.color = colourForId(plane.id, 1.0f);
+  for (const auto& v : hull) outline.points.push_back(toPoint(v));
+  outline.points.push_back(toPoint(hull.front()));
+  markers.push_back(outline);
+
+  visualization_msgs::Marker arrow = baseMarker(header, "normals", plane.id, visualization_msgs::Marker::ARROW);
+  arrow.scale.x = 0.03;
+  arrow.scale.y = 0.06;
+  arrow.scale.z = 0.08;
+  arrow.color = colourForId(plane.id, 1.0f);
+  arrow.points.push_back(toPoint(centre));
+  arrow.points.push_back(toPoint(centre + 0.3 * plane.normal));
+  markers.push_back(arrow);
+
+  visualization_msgs::Marker label = baseMarker(header, "labels", plane.id, visualization_msgs::Marker::TEXT_VIEW_FACING);
+  label.pose.position = toPoint(centre + 0.35 * plane.normal);
+  label.scale.z = 0.2;
+  label.color = colourForId(plane.id, 1.0f);
+  label.text = std::to_string(plane.id);
+  markers.push_back(label);
+}
+
+void fillSegmentedCloud(const std_msgs::Header& header, const CloudView& view, const std::vector<int>& labels,
+                        sensor_msgs::PointCloud2& out)
+{
+  out.header = header;
+  sensor_msgs::PointCloud2Modifier modifier(out);
+  modifier.setPointCloud2Fields(5, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32,
+                                "z", 1, sensor_msgs::PointField::FLOAT32, "rgb", 1, sensor_msgs::PointField::FLOAT32,
+                                "label", 1, sensor_msgs::PointField::INT32);
+  out.height = view.height;
+  out.width = view.width;
+  modifier.resize(static_cast<size_t>(view.width) * view.height);
+  out.height = view.height;
+  out.width = view.width;
+  out.row_step = out.point_step * out.width;
+  out.is_dense = false;
+  sensor_msgs::PointCloud2Iterator<float> x(out, "x"), rgb(out, "rgb");
+  sensor_msgs::PointCloud2Iterator<int32_t> label(out, "label");
+  for (int v = 0; v < view.height; ++v)
+    for (int u = 0; u < view.width; ++u, ++x, ++rgb, ++label)
+    {
+      view.point(u, v, x[0], x[1], x[2]);
+      const int id = labels[static_cast<size_t>(v) * view.width + u];
+      *label = id;
+      uint8_t r = 128, g = 128, b = 128;  // grey: on no plane
+      if (id >= 0)
+      {
+        const std_msgs::ColorRGBA c = colourForId(id, 1.0f);
+        r = static_cast<uint8_t>(255 * c.r);
+        g = static_cast<uint8_t>(255 * c.g);
+        b = static_cast<uint8_t>(255 * c.b);
+      }
+      const uint32_t packed = (static_cast<uint32_t>(r) << 16) | (static_cast<uint32_t>(g) << 8) | b;
+      std::memcpy(&*rgb, &packed, sizeof(float));
+    }
+}
+
+}  // namespace hough_plane_detector
