@@ -7,7 +7,7 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all deps build test demo bench clean
+.PHONY: all deps build test demo demo-offline bench clean
 
 all: build
 
@@ -28,7 +28,13 @@ test: build
 	@grep -E "^\[ *(RUN|OK|FAILED|PASSED) *\]|Failure|error:" $(WS)/run_tests.log | grep -v "^\[ *RUN" || true
 	@scripts/test_summary.py $(WS)/build/test_results
 
+# The whole ROS path for about 20 s (simulated Kinect -> detector nodelet), then the map against
+# the truth and a picture; roslaunch starts its own master when none runs.
 demo: build
+	@scripts/run_demo.sh $(CURDIR)/$(WS) 20 $(CURDIR)/build/demo.png
+
+# The core alone on the same simulated room, with per-frame figures.
+demo-offline: build
 	$(BIN)/hough_demo
 
 bench: build
