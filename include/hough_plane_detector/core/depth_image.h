@@ -1,0 +1,21 @@
+// Organized points from a depth image (OpenNI2 gives 16-bit millimetres per pixel).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "hough_plane_detector/core/scene_renderer.h"
+
+namespace hough_plane_detector
+{
+
+// Points in the camera optical frame (x right, y down, z forward), 3 floats per pixel, row by
+// row; NaN where the depth is 0 or outside [min_range, max_range]. row_stride in bytes.
+void depthImageToPoints(const uint16_t* depth, int width, int height, size_t row_stride,
+                        const CameraIntrinsics& intrinsics, double metres_per_unit, std::vector<float>& points);
+
+// Pinhole intrinsics of a sensor from its image size and fields of view (radians).
+CameraIntrinsics intrinsicsFromFieldOfView(int width, int height, double horizontal_fov, double vertical_fov);
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,42 @@
+#include "hough_plane_detector/core/depth_image.h"
+
+#include <cmath>
+#include <limits>
+
+namespace hough_plane_detector
+{
+
+void depthImageToPoints(const uint16_t* depth, int width, int height, size_t row_stride,
+                        const CameraIntrinsics& k, double metres_per_unit, std::vector<float>& points)
+{
+  points.assign(static_cast<size_t>(width) * height * 3, std::numeric_limits<float>::quiet_NaN());
+  for (int v = 0; v < height; ++v)
+  {
+    const uint16_t* row = reinterpret_cast<const uint16_t*>(reinterpret_cast<const uint8_t*>(depth) + v * row_stride);
+    for (int u = 0; u < width; ++u)
+    {
+      const double z = row[u] * metres_per_unit;
+      if (row[u] == 0 || z < k.min_range || z > k.max_range) continue;  // 0: no return
+      float* p = &points[(static_cast<size_t>(v) * width + u) * 3];
+      p[0] = static_cast<float>((u - k.cx) / k.fx * z);
+      p[1] = static_cast<float>((v - k.cy) / k.fy * z);
+      p[2] = static_cast<float>(z);
+    }
+  }
+}
+
+CameraIntrinsics intrinsicsFromFieldOfView(int width, int height, double horizontal_fov, double vertical_fov)
+{
+  CameraIntrinsics k;
+  k.width = width;
+  k.height = height;
+  k.fx = width / (2.0 * std::tan(horizontal_fov / 2.0));
+  k.fy = height / (2.0 * std::tan(vertical_fov / 2.0));
+  k.cx = (width - 1) / 2.0;
+  k.cy = (height - 1) / 2.0;
+  k.min_range = 0.3;
+  k.max_range = 10.0;
+  return k;
+}
+
+}  // namespace hough_plane_detector
