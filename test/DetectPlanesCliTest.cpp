@@ -18,8 +18,10 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "hough_plane_detector/core/scene_renderer.h"
+#include "test_bags.h"
 
 using namespace hough_plane_detector;
+using namespace hough_plane_detector::test;
 
 namespace
 {
@@ -43,109 +45,6 @@ RunResult run(const std::string& args)
 std::string tempPath(const std::string& name)
 {
   return testing::TempDir() + "detect_planes_cli_" + name;
-}
-
-// A driver-like cloud: x y z, 4 bytes padding, rgb, 12 more bytes: point_step 32.
-sensor_msgs::PointCloud2 toCloudMessage(const RenderedFrame& frame, const std::string& frame_id, double stamp)
-{
-  sensor_msgs::PointCloud2 msg;
-  msg.header.frame_id = frame_id;
-  msg.header.stamp.fromSec(stamp);
-  msg.width = frame.width;
-  msg.height = frame.height;
-  msg.point_step = 32;
-  msg.row_step = msg.point_step * msg.width;
-  msg.is_dense = false;
-  const char* names[4] = {"x", "y", "z", "rgb"};
-  const uint32_t offsets[4] = {0, 4, 8, 16};
-  for (int i = 0; i < 4; ++i)
-  {
-    sensor_msgs::PointField f;
-    f.name = names[i];
-    f.offset = offsets[i];
-    f.datatype = sensor_msgs::PointField::FLOAT32;
-    f.count = 1;
-    msg.fields.push_back(f);
-  }
-  msg.data.assign(static_cast<size_t>(msg.row_step) * msg.height, 0);
-  for (size_t i = 0; i < static_cast<size_t>(frame.width) * frame.height; ++i)
-  {
-    std::memcpy(&msg.data[i * 32], &frame.xyz[i * 3], 12);
-    const float rgb = 1.0f;
-    std::memcpy(&msg.data[i * 32 + 16], &rgb, 4);
-  }
-  return msg;
-}
-
-geometry_msgs::TransformStamped toTransform(const Eigen::Isometry3d& t, const std::string& parent,
-                                            const std::string& child, double stamp)
-{
-  geometry_msgs::TransformStamped msg;
-  msg.header.frame_id = parent;
-  msg.header.stamp.fromSec(stamp);
-  msg.child_frame_id = child;
-  msg.transform.translation.x = t.translation().x();
-  msg.transform.translation.y = t.translation().y();
-  msg.transform.translation.z = t.translation().z();
-  const Eigen::Quaterniond q(t.linear());
-  msg.transform.rotation.x = q.x();
-  msg.transform.rotation.y = q.y();
-  msg.transform.rotation.z = q.z();
-  msg.transform.rotation.w = q.w();
-  return msg;
-}
-
-// The usual Kinect tree: odom -> camera_link (moving) -> camera_depth_optical_frame (static).
-// `tf_for_frame(f)` decides whether frame f gets its odometry transform.
-void writeBag(const std::string& path, int frames, bool (*tf_for_frame)(int))
-{
-  SceneRenderer renderer(makeOfficeRoom());
-  const auto poses = roomTour(40);
-  Eigen::Isometry3d link_to_optical = Eigen::Isometry3d::Identity();
-  link_to_optical.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // optical z forward = link x
-  rosbag::Bag bag(path, rosbag::bagmode::Write);
-  tf2_msgs::TFMessage static_tf;
-  static_tf.transforms.push_back(toTransform(link_to_optical, "camera_link", "camera_depth_optical_frame", 100.0));
-  bag.write("/tf_static", ros::Time(100.0), static_tf);
-  KinectNoise noise;
-  noise.coefficient = 0.5;
-  for (int f = 0; f < frames; ++f)
-  {
-    const double stamp = 100.0 + 0.1 * f;
-    const RenderedFrame frame = renderer.render(poses[f], noise, f);
-    bag.write("/camera/depth/points", ros::Time(stamp), toCloudMessage(frame, "camera_depth_optical_frame", stamp));
-    if (!tf_for_frame(f)) continue;
-    tf2_msgs::TFMessage tf;
-    tf.transforms.push_back(toTransform(poses[f] * link_to_optical.inverse(), "odom", "camera_link", stamp));
-    bag.write("/tf", ros::Time(stamp + 0.01), tf);  // tf after the cloud, as in real bags
-  }
-  bag.close();
-}
-
-struct JsonPlane
-{
-  Eigen::Vector3d normal;
-  double d;
-};
-
-std::vector<std::vector<JsonPlane>> parseFrames(const std::string& output, std::vector<std::string>* frame_ids = nullptr)
-{
-  std::vector<std::vector<JsonPlane>> frames;
-  const std::regex plane_re(R"re("normal": \[([-0-9.e]+), ([-0-9.e]+), ([-0-9.e]+)\], "d": ([-0-9.e]+))re");
-  const std::regex frame_re(R"re(^\{"frame": \d+, "stamp": [-0-9.e]+, "frame_id": "([^"]*)", "ms": [0-9.e]+, "planes": \[)re");
-  std::istringstream lines(output);
-  std::string line;
-  while (std::getline(lines, line))
-  {
-    std::smatch m;
-    if (!std::regex_search(line, m, frame_re)) continue;
-    if (frame_ids) frame_ids->push_back(m[1]);
-    std::vector<JsonPlane> planes;
-    for (auto it = std::sregex_iterator(line.begin(), line.end(), plane_re); it != std::sregex_iterator(); ++it)
-      planes.push_back({Eigen::Vector3d(std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3])), std::stod((*it)[4])});
-    frames.push_back(planes);
-  }
-  return frames;
 }
 
 bool hasPlane(const std::vector<JsonPlane>& planes, const Eigen::Vector3d& n, double d)

@@ -190,6 +190,10 @@ private:
     std::string error = makeCloudView(layoutOf(*cloud), view, converted);
 
     std::lock_guard<std::mutex> lock(map_mutex_);
+    // The subscriber queue drops the oldest clouds when the detector falls behind; drivers
+    // number their messages, so gaps in header.seq count them.
+    if (last_seq_ != 0 && cloud->header.seq > last_seq_ + 1) frames_queue_dropped_ += cloud->header.seq - last_seq_ - 1;
+    last_seq_ = cloud->header.seq;
     arrivals_.push_back(ros::WallTime::now());
     while (arrivals_.size() > 30) arrivals_.pop_front();
     if (error.empty()) detector_->processFrame(view, camera_to_world, cloud->header.stamp.toSec(), &error);
@@ -326,7 +330,7 @@ private:
       rate = (arrivals_.size() - 1) / std::max(1e-6, (arrivals_.back() - arrivals_.front()).toSec());
     if (frames_processed_ == 0)
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no cloud processed yet");
-    else if (frames_dropped_ + frames_rejected_ > 0)
+    else if (frames_dropped_ + frames_rejected_ + frames_queue_dropped_ > 0)
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "some clouds were skipped");
     else
       status.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
@@ -334,6 +338,7 @@ private:
     status.add("ms per frame (last)", last_ms_);
     status.add("frames processed", frames_processed_);
     status.add("frames skipped (no transform)", frames_dropped_);
+    status.add("frames dropped (queue full, detector behind)", frames_queue_dropped_);
     status.add("frames refused (bad cloud)", frames_rejected_);
     status.add("planes", detector_->planes().size());
     status.add("Hough space MB", memory.global_bytes / 1e6);
@@ -352,6 +357,8 @@ private:
   ros::Time last_stamp_;
   double last_ms_ = 0.0;
   int frames_processed_ = 0, frames_dropped_ = 0, frames_rejected_ = 0;
+  uint64_t frames_queue_dropped_ = 0;
+  uint32_t last_seq_ = 0;
   std::deque<ros::WallTime> arrivals_;
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;

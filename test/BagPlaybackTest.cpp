@@ -1,0 +1,88 @@
+// rosbag play --clock into the running nodelet gives the planes detect_planes finds offline.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <mutex>
+
+#include <ros/ros.h>
+
+#include "hough_plane_detector/PlaneArray.h"
+#include "test_bags.h"
+
+using namespace hough_plane_detector;
+using namespace hough_plane_detector::test;
+
+namespace
+{
+bool always(int) { return true; }
+
+std::string runCommand(const std::string& command, int* exit_code)
+{
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  std::string output;
+  char buffer[4096];
+  while (pipe && fgets(buffer, sizeof(buffer), pipe)) output += buffer;
+  const int status = pipe ? pclose(pipe) : -1;
+  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return output;
+}
+}  // namespace
+
+TEST(BagPlayback, NodeletOnAPlayedBagMatchesTheOfflineTool)
+{
+  const std::string bag = "/tmp/hough_plane_detector_playback_test.bag";
+  const int frames = 12;
+  writeBag(bag, frames, always);
+
+  ros::NodeHandle private_nh("~");
+  std::string detect_planes = DETECT_PLANES_BINARY;
+  int code = 0;
+  const std::string offline = runCommand(detect_planes + " --bag " + bag + " --topic /camera/depth/points", &code);
+  ASSERT_EQ(code, 0) << offline;
+  const auto expected_frames = parseFrames(offline);
+  ASSERT_EQ(expected_frames.size(), static_cast<size_t>(frames)) << offline;
+  const auto& expected = expected_frames.back();
+  ASSERT_GE(expected.size(), 3u) << offline;
+
+  std::mutex mutex;
+  std::vector<PlaneArray::ConstPtr> received;
+  ros::NodeHandle nh;
+  ros::Subscriber sub = nh.subscribe<PlaneArray>("/hough_plane_detector/planes", 100, [&](const PlaneArray::ConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    received.push_back(m);
+  });
+  ros::WallDuration(2.0).sleep();  // let the subscription connect
+  const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 1 " + bag, &code);
+  ASSERT_EQ(code, 0) << played;
+  ros::WallDuration(2.0).sleep();
+
+  std::lock_guard<std::mutex> lock(mutex);
+  std::string stamps;
+  for (const auto& m : received) stamps += " " + std::to_string(m->header.stamp.toSec());
+  ASSERT_EQ(received.size(), static_cast<size_t>(frames)) << "every played cloud gives one plane array; got" << stamps;
+  const PlaneArray& last = *received.back();
+  EXPECT_EQ(last.header.frame_id, "odom");
+  EXPECT_NEAR(last.header.stamp.toSec(), 100.0 + 0.1 * (frames - 1), 1e-6);
+  ASSERT_EQ(last.planes.size(), expected.size()) << offline;
+  for (size_t i = 0; i < expected.size(); ++i)
+  {
+    const Plane& p = last.planes[i];
+    EXPECT_NEAR(p.normal.x, expected[i].normal.x(), 1e-4);
+    EXPECT_NEAR(p.normal.y, expected[i].normal.y(), 1e-4);
+    EXPECT_NEAR(p.normal.z, expected[i].normal.z(), 1e-4);
+    EXPECT_NEAR(p.d, expected[i].d, 1e-4);
+  }
+}
+
+int main(int argc, char** argv)
+{
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_bag_playback");
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  spinner.stop();
+  return result;
+}
