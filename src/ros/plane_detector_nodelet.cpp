@@ -31,59 +31,22 @@ namespace hough_plane_detector
 
 namespace
 {
-DetectorParams toParams(const HoughPlaneDetectorConfig& c)
+// The .cfg declares the same names as the core's parameter list.
+#define HPD_COPY(type, name) to.name = from.name;
+DetectorParams toParams(const HoughPlaneDetectorConfig& from)
 {
-  DetectorParams p;
-  p.resolution = c.resolution;
-  p.angle_step = c.angle_step;
-  p.d_step = c.d_step;
-  p.max_distance = c.max_distance;
-  p.blur_sigma = c.blur_sigma;
-  p.blur_kernel_size = c.blur_kernel_size;
-  p.peak_window = c.peak_window;
-  p.local_threshold = c.local_threshold;
-  p.min_support = c.min_support;
-  p.global_threshold = c.global_threshold;
-  p.thinning_rate = c.thinning_rate;
-  p.permanence_cap = c.permanence_cap;
-  p.merge_angle = c.merge_angle;
-  p.merge_distance = c.merge_distance;
-  p.normal_window = c.normal_window;
-  p.normal_stride = c.normal_stride;
-  p.min_valid_fraction = c.min_valid_fraction;
-  p.max_curvature = c.max_curvature;
-  p.sensor_noise = c.sensor_noise;
-  p.support_distance = c.support_distance;
-  p.support_angle = c.support_angle;
-  return p;
+  DetectorParams to;
+  HOUGH_PLANE_DETECTOR_PARAMS(HPD_COPY)
+  return to;
 }
 
-HoughPlaneDetectorConfig toConfig(const DetectorParams& p)
+HoughPlaneDetectorConfig toConfig(const DetectorParams& from)
 {
-  HoughPlaneDetectorConfig c;
-  c.resolution = p.resolution;
-  c.angle_step = p.angle_step;
-  c.d_step = p.d_step;
-  c.max_distance = p.max_distance;
-  c.blur_sigma = p.blur_sigma;
-  c.blur_kernel_size = p.blur_kernel_size;
-  c.peak_window = p.peak_window;
-  c.local_threshold = p.local_threshold;
-  c.min_support = p.min_support;
-  c.global_threshold = p.global_threshold;
-  c.thinning_rate = p.thinning_rate;
-  c.permanence_cap = p.permanence_cap;
-  c.merge_angle = p.merge_angle;
-  c.merge_distance = p.merge_distance;
-  c.normal_window = p.normal_window;
-  c.normal_stride = p.normal_stride;
-  c.min_valid_fraction = p.min_valid_fraction;
-  c.max_curvature = p.max_curvature;
-  c.sensor_noise = p.sensor_noise;
-  c.support_distance = p.support_distance;
-  c.support_angle = p.support_angle;
-  return c;
+  HoughPlaneDetectorConfig to;
+  HOUGH_PLANE_DETECTOR_PARAMS(HPD_COPY)
+  return to;
 }
+#undef HPD_COPY
 }  // namespace
 
 class PlaneDetectorNodelet : public nodelet::Nodelet

@@ -16,31 +16,21 @@ struct ParamEntry
   double DetectorParams::*double_member;
 };
 
+ParamEntry entry(const char* name, int DetectorParams::*member)
+{
+  return ParamEntry{name, member, nullptr};
+}
+
+ParamEntry entry(const char* name, double DetectorParams::*member)
+{
+  return ParamEntry{name, nullptr, member};
+}
+
 const std::vector<ParamEntry>& paramTable()
 {
-  static const std::vector<ParamEntry> table = {
-    {"resolution", &DetectorParams::resolution, nullptr},
-    {"angle_step", nullptr, &DetectorParams::angle_step},
-    {"d_step", nullptr, &DetectorParams::d_step},
-    {"max_distance", nullptr, &DetectorParams::max_distance},
-    {"blur_sigma", nullptr, &DetectorParams::blur_sigma},
-    {"blur_kernel_size", &DetectorParams::blur_kernel_size, nullptr},
-    {"peak_window", &DetectorParams::peak_window, nullptr},
-    {"local_threshold", nullptr, &DetectorParams::local_threshold},
-    {"min_support", &DetectorParams::min_support, nullptr},
-    {"global_threshold", nullptr, &DetectorParams::global_threshold},
-    {"thinning_rate", nullptr, &DetectorParams::thinning_rate},
-    {"permanence_cap", nullptr, &DetectorParams::permanence_cap},
-    {"merge_angle", nullptr, &DetectorParams::merge_angle},
-    {"merge_distance", nullptr, &DetectorParams::merge_distance},
-    {"normal_window", &DetectorParams::normal_window, nullptr},
-    {"normal_stride", &DetectorParams::normal_stride, nullptr},
-    {"min_valid_fraction", nullptr, &DetectorParams::min_valid_fraction},
-    {"max_curvature", nullptr, &DetectorParams::max_curvature},
-    {"sensor_noise", nullptr, &DetectorParams::sensor_noise},
-    {"support_distance", nullptr, &DetectorParams::support_distance},
-    {"support_angle", nullptr, &DetectorParams::support_angle},
-  };
+#define HPD_PARAM_ENTRY(type, name) entry(#name, &DetectorParams::name),
+  static const std::vector<ParamEntry> table = {HOUGH_PLANE_DETECTOR_PARAMS(HPD_PARAM_ENTRY)};
+#undef HPD_PARAM_ENTRY
   return table;
 }
 

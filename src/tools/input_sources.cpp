@@ -14,16 +14,7 @@ namespace hough_plane_detector
 
 PointBufferLayout layoutOf(const pcl::PCLPointCloud2& cloud)
 {
-  PointBufferLayout layout;
-  layout.width = cloud.width;
-  layout.height = cloud.height;
-  layout.point_step = cloud.point_step;
-  layout.row_step = cloud.row_step;
-  layout.is_bigendian = cloud.is_bigendian;
-  for (const auto& f : cloud.fields) layout.fields.push_back(PointFieldLayout{f.name, f.offset, f.datatype, f.count});
-  layout.data = cloud.data.data();
-  layout.data_size = cloud.data.size();
-  return layout;
+  return layoutOfCloud(cloud);
 }
 
 bool loadPcd(const std::string& path, pcl::PCLPointCloud2& cloud, std::string* error)

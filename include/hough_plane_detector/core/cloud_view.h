@@ -60,6 +60,23 @@ struct PointBufferLayout
   size_t data_size = 0;
 };
 
+// The layout of any PointCloud2-shaped cloud (sensor_msgs::PointCloud2, pcl::PCLPointCloud2):
+// both name their members the same way.
+template <class Cloud>
+PointBufferLayout layoutOfCloud(const Cloud& cloud)
+{
+  PointBufferLayout layout;
+  layout.width = cloud.width;
+  layout.height = cloud.height;
+  layout.point_step = cloud.point_step;
+  layout.row_step = cloud.row_step;
+  layout.is_bigendian = cloud.is_bigendian;
+  for (const auto& f : cloud.fields) layout.fields.push_back(PointFieldLayout{f.name, f.offset, f.datatype, f.count});
+  layout.data = cloud.data.data();
+  layout.data_size = cloud.data.size();
+  return layout;
+}
+
 // Checks the layout and makes a view of it. Float32 x/y/z are viewed in place; other numeric
 // types are converted into `converted`, which must outlive the view. Returns an empty string
 // on success, otherwise what is wrong with the buffer.

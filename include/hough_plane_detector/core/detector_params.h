@@ -3,6 +3,31 @@
 
 #include <string>
 
+// Every parameter as X(type, name), in one place: the CLI flags, the nodelet's ROS parameters
+// and its dynamic_reconfigure config are all generated from this list.
+#define HOUGH_PLANE_DETECTOR_PARAMS(X) \
+  X(int, resolution)                   \
+  X(double, angle_step)                \
+  X(double, d_step)                    \
+  X(double, max_distance)              \
+  X(double, blur_sigma)                \
+  X(int, blur_kernel_size)             \
+  X(int, peak_window)                  \
+  X(double, local_threshold)           \
+  X(int, min_support)                  \
+  X(double, global_threshold)          \
+  X(double, thinning_rate)             \
+  X(double, permanence_cap)            \
+  X(double, merge_angle)               \
+  X(double, merge_distance)            \
+  X(int, normal_window)                \
+  X(int, normal_stride)                \
+  X(double, min_valid_fraction)        \
+  X(double, max_curvature)             \
+  X(double, sensor_noise)              \
+  X(double, support_distance)          \
+  X(double, support_angle)
+
 namespace hough_plane_detector
 {
 
