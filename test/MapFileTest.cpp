@@ -158,12 +158,22 @@ TEST(PlaneExtent, HullCoversTheSeenPartOfTheFloorAndFades)
   for (size_t i = 0; i < hull.size(); ++i) area += hull[i].cross(hull[(i + 1) % hull.size()]);
   EXPECT_GT(area.dot(floor->normal), 0.5) << "the patch covers at least 0.25 m^2, facing the normal";
 
+  // A cell seen twice outlives one seen once by 1 / fade frames.
   PlaneExtent extent;
-  extent.add(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(1.02, 2.01, 0.0));
-  extent.add(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(1.02, 2.01, 0.0));
-  extent.add(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d(-0.5, 0.3, 0.0));
+  const PlaneBasis floor_basis(Eigen::Vector3d::UnitZ(), 0.0);
+  extent.add(floor_basis.project({1.02, 2.01, 0.0}), 1, 0.5f);
+  extent.add(floor_basis.project({1.02, 2.01, 0.0}), 1, 0.5f);
+  extent.add(floor_basis.project({-0.5, 0.3, 0.0}), 1, 0.5f);
   EXPECT_EQ(extent.cellCount(), 2u);
-  extent.decay(1.5f);  // the cell seen once goes, the one seen twice stays
+  EXPECT_EQ(extent.hull(floor_basis, 2, 0.5f).size(), 6u);  // two diagonal squares: a hexagon
+  extent.sweep(3, 0.5f);  // the cell seen once has faded, the one seen twice stays
   EXPECT_EQ(extent.cellCount(), 1u);
-  EXPECT_EQ(extent.hull(Eigen::Vector3d::UnitZ(), 0.0).size(), 4u);  // one 5 cm square
+  const auto square = extent.hull(floor_basis, 3, 0.5f);
+  ASSERT_EQ(square.size(), 4u);  // one 5 cm square around (1.02, 2.01)
+  for (const auto& p : square)
+  {
+    EXPECT_NEAR(p.x(), 1.025, 0.026);
+    EXPECT_NEAR(p.y(), 2.025, 0.026);
+  }
+  EXPECT_TRUE(extent.hull(floor_basis, 10, 0.5f).empty()) << "faded out entirely";
 }

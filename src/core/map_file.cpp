@@ -75,6 +75,7 @@ std::string PlaneDetector::serializeMap() const
   w.put(static_cast<int32_t>(param_.sizeAngle()));
   w.put(static_cast<int32_t>(param_.sizeD()));
   w.put(static_cast<int32_t>(next_id_));
+  w.put(frame_count_);
   w.put(static_cast<uint32_t>(planes_.size()));
   for (const DetectedPlane& p : planes_)
   {
@@ -107,7 +108,8 @@ std::string PlaneDetector::serializeMap() const
     {
       w.put(cell.first.first);
       w.put(cell.first.second);
-      w.put(cell.second);
+      w.put(cell.second.weight);
+      w.put(cell.second.seen);
     }
   }
   w.put(fnv1a(w.bytes.data(), w.bytes.size()));
@@ -138,9 +140,10 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
 
   double angle_step, d_step, max_distance;
   int32_t size_angle, size_d, next_id;
+  int64_t frame_count;
   uint32_t plane_count;
   if (!r.get(angle_step) || !r.get(d_step) || !r.get(max_distance) || !r.get(size_angle) || !r.get(size_d) ||
-      !r.get(next_id) || !r.get(plane_count))
+      !r.get(next_id) || !r.get(frame_count) || !r.get(plane_count))
     return fail("map header is truncated");
   if (std::abs(angle_step - param_.angleStep()) > 1e-12 || std::abs(d_step - param_.dStep()) > 1e-12 ||
       std::abs(max_distance - param_.maxDistance()) > 1e-12 || size_angle != param_.sizeAngle() ||
@@ -189,9 +192,9 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
     for (uint32_t c = 0; c < cell_count; ++c)
     {
       int32_t x, y;
-      float weight;
-      if (!r.get(x) || !r.get(y) || !r.get(weight)) return fail("map extents are truncated");
-      extent.setCell(x, y, weight);
+      PlaneExtent::Cell cell;
+      if (!r.get(x) || !r.get(y) || !r.get(cell.weight) || !r.get(cell.seen)) return fail("map extents are truncated");
+      extent.setCell(x, y, cell);
     }
   }
   if (r.position() != bytes.size() - sizeof(uint64_t)) return fail("map has trailing bytes");
@@ -203,6 +206,7 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
   planes_ = planes;
   extents_.swap(extents);
   next_id_ = next_id;
+  frame_count_ = frame_count;
   samples_.clear();
   sample_labels_.clear();
   block_labels_.clear();

@@ -59,6 +59,7 @@ PlaneDetector::PlaneDetector(const DetectorParams& params)
 void PlaneDetector::reset()
 {
   extents_.clear();
+  frame_count_ = 0;
   global_.clear();
   local_.clear();
   planes_.clear();
@@ -95,6 +96,7 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
   timings_ = StageTimings();
   stats_ = FrameStats();
   camera_to_world_ = camera_to_world;
+  ++frame_count_;
   const auto frame_start = Clock::now();
 
   auto t = Clock::now();
@@ -693,24 +695,27 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   for (DetectedPlane& plane : planes_)
     if (plane.support >= params_.min_support) plane.last_seen = stamp;
 
-  // Extents: this frame's labelled blocks mark their cells; every cell fades like the space.
+  // Extents: this frame's labelled blocks mark their cells; cells fade like the Hough space
+  // (lazily, swept every 16 frames); extents of planes that left the map go with them.
+  const float fade = static_cast<float>(params_.thinning_rate);
   std::unordered_map<int, PlaneExtent> extents;
+  std::unordered_map<int, std::pair<PlaneExtent*, PlaneBasis>> by_id;
   for (const DetectedPlane& plane : planes_)
   {
     auto it = extents_.find(plane.id);
-    if (it != extents_.end()) extents[plane.id] = std::move(it->second);
-    extents[plane.id].decay(static_cast<float>(params_.thinning_rate));
+    PlaneExtent& extent = extents[plane.id];
+    if (it != extents_.end()) extent = std::move(it->second);
+    if (frame_count_ % 16 == 0) extent.sweep(frame_count_, fade);
+    by_id.emplace(plane.id, std::make_pair(&extent, PlaneBasis(plane.normal, plane.d)));
   }
-  extents_.swap(extents);
-  std::unordered_map<int, const DetectedPlane*> by_id;
-  for (const DetectedPlane& plane : planes_) by_id[plane.id] = &plane;
   for (size_t b = 0; b < block_labels_.size(); ++b)
   {
     if (block_labels_[b] < 0) continue;
-    const DetectedPlane& plane = *by_id[block_labels_[b]];
+    const auto& target = by_id.at(block_labels_[b]);
     const PointMoments& block = normals_.block(static_cast<int>(b) % normals_.blocksX(), static_cast<int>(b) / normals_.blocksX());
-    extents_[plane.id].add(plane.normal, plane.d, camera_to_world_ * block.mean());
+    target.first->add(target.second.project(camera_to_world_ * block.mean()), frame_count_, fade);
   }
+  extents_.swap(extents);
 }
 
 }  // namespace hough_plane_detector
@@ -727,7 +732,8 @@ const PlaneExtent* PlaneDetector::extent(int id) const
 std::vector<Eigen::Vector3d> PlaneDetector::hull(const DetectedPlane& plane) const
 {
   const PlaneExtent* e = extent(plane.id);
-  return e ? e->hull(plane.normal, plane.d) : std::vector<Eigen::Vector3d>();
+  return e ? e->hull(PlaneBasis(plane.normal, plane.d), frame_count_, static_cast<float>(params_.thinning_rate))
+           : std::vector<Eigen::Vector3d>();
 }
 
 void PlaneDetector::labelPixels(const CloudView& cloud, std::vector<int>& labels) const

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace hough_plane_detector
 {
 
-void planeBasis(const Eigen::Vector3d& normal, double d, Eigen::Vector3d& origin, Eigen::Vector3d& u,
-                Eigen::Vector3d& v)
+PlaneBasis::PlaneBasis(const Eigen::Vector3d& normal, double d)
 {
   // The world axis least aligned with the normal fixes u, so the basis does not spin with
   // small changes of the normal.
@@ -18,49 +18,59 @@ void planeBasis(const Eigen::Vector3d& normal, double d, Eigen::Vector3d& origin
   origin = -d * normal;
 }
 
-void PlaneExtent::add(const Eigen::Vector3d& normal, double d, const Eigen::Vector3d& point)
+Eigen::Vector2d PlaneBasis::project(const Eigen::Vector3d& point) const
 {
-  Eigen::Vector3d origin, u, v;
-  planeBasis(normal, d, origin, u, v);
   const Eigen::Vector3d q = point - origin;
-  const int32_t x = static_cast<int32_t>(std::floor(q.dot(u) / kCellSize));
-  const int32_t y = static_cast<int32_t>(std::floor(q.dot(v) / kCellSize));
+  return Eigen::Vector2d(q.dot(u), q.dot(v));
+}
+
+void PlaneExtent::add(const Eigen::Vector2d& point, int64_t frame, float fade)
+{
+  const int32_t x = static_cast<int32_t>(std::floor(point.x() / kCellSize));
+  const int32_t y = static_cast<int32_t>(std::floor(point.y() / kCellSize));
   auto it = cells_.find(key(x, y));
   if (it == cells_.end())
   {
     if (cells_.size() >= kMaxCells) return;  // bounded memory
-    cells_.emplace(key(x, y), 1.0f);
+    cells_.emplace(key(x, y), Cell{1.0f, frame});
+    return;
   }
-  else
-  {
-    it->second = std::min(kMaxWeight, it->second + 1.0f);
-  }
+  // Fading is applied lazily: a cell's weight is brought up to date when it is touched.
+  it->second.weight = std::min(kMaxWeight, std::max(0.0f, weightAt(it->second, frame, fade)) + 1.0f);
+  it->second.seen = frame;
 }
 
-void PlaneExtent::decay(float amount)
+void PlaneExtent::sweep(int64_t frame, float fade)
 {
   for (auto it = cells_.begin(); it != cells_.end();)
   {
-    it->second -= amount;
-    if (it->second <= 0.0f)
+    if (weightAt(it->second, frame, fade) <= 0.0f)
       it = cells_.erase(it);
     else
       ++it;
   }
 }
 
-std::vector<Eigen::Vector3d> PlaneExtent::hull(const Eigen::Vector3d& normal, double d) const
+std::vector<Eigen::Vector3d> PlaneExtent::hull(const PlaneBasis& basis, int64_t frame, float fade) const
 {
-  std::vector<Eigen::Vector2d> corners;
-  corners.reserve(cells_.size() * 4);
+  // Only the outermost live cell of each row can be on the hull.
+  std::map<int32_t, std::pair<int32_t, int32_t>> rows;
   for (const auto& cell : cells_)
   {
-    const double x = static_cast<int32_t>(cell.first >> 32) * kCellSize;
-    const double y = static_cast<int32_t>(cell.first & 0xffffffffu) * kCellSize;
-    corners.emplace_back(x, y);
-    corners.emplace_back(x + kCellSize, y);
-    corners.emplace_back(x, y + kCellSize);
-    corners.emplace_back(x + kCellSize, y + kCellSize);
+    if (weightAt(cell.second, frame, fade) <= 0.0f) continue;
+    const int32_t x = static_cast<int32_t>(cell.first >> 32), y = static_cast<int32_t>(cell.first & 0xffffffffu);
+    auto it = rows.find(y);
+    if (it == rows.end())
+      rows.emplace(y, std::make_pair(x, x));
+    else
+      it->second = {std::min(it->second.first, x), std::max(it->second.second, x)};
+  }
+  std::vector<Eigen::Vector2d> corners;
+  for (const auto& row : rows)
+  {
+    const double y = row.first * kCellSize;
+    const double x0 = row.second.first * kCellSize, x1 = (row.second.second + 1) * kCellSize;
+    corners.insert(corners.end(), {{x0, y}, {x0, y + kCellSize}, {x1, y}, {x1, y + kCellSize}});
   }
   std::vector<Eigen::Vector3d> polygon;
   if (corners.size() < 3) return polygon;
@@ -85,24 +95,22 @@ std::vector<Eigen::Vector3d> PlaneExtent::hull(const Eigen::Vector3d& normal, do
     chain[k++] = corners[i - 1];
   }
   chain.resize(k - 1);
-  Eigen::Vector3d origin, u, v;
-  planeBasis(normal, d, origin, u, v);
-  for (const auto& c : chain) polygon.push_back(origin + c.x() * u + c.y() * v);
+  for (const auto& c : chain) polygon.push_back(basis.lift(c));
   return polygon;
 }
 
-std::vector<std::pair<std::pair<int32_t, int32_t>, float>> PlaneExtent::cells() const
+std::vector<std::pair<std::pair<int32_t, int32_t>, PlaneExtent::Cell>> PlaneExtent::cells() const
 {
-  std::vector<std::pair<std::pair<int32_t, int32_t>, float>> out;
+  std::vector<std::pair<std::pair<int32_t, int32_t>, Cell>> out;
   for (const auto& cell : cells_)
     out.push_back({{static_cast<int32_t>(cell.first >> 32), static_cast<int32_t>(cell.first & 0xffffffffu)}, cell.second});
-  std::sort(out.begin(), out.end());
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   return out;
 }
 
-void PlaneExtent::setCell(int32_t x, int32_t y, float weight)
+void PlaneExtent::setCell(int32_t x, int32_t y, const Cell& cell)
 {
-  cells_[key(x, y)] = weight;
+  cells_[key(x, y)] = cell;
 }
 
 }  // namespace hough_plane_detector

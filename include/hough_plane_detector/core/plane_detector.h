@@ -182,6 +182,7 @@ private:
   std::vector<Peak> local_peaks_;
   std::vector<DetectedPlane> planes_;
   std::unordered_map<int, PlaneExtent> extents_;
+  int64_t frame_count_ = 0;  // frames processed since the map began (extents fade by it)
   int next_id_ = 0;
   StageTimings timings_;
   FrameStats stats_;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -13,6 +14,15 @@
 namespace hough_plane_detector
 {
 
+// In-plane axes (u, v) and origin of the plane n.p + d = 0, the same for the same plane.
+struct PlaneBasis
+{
+  PlaneBasis(const Eigen::Vector3d& normal, double d);
+  Eigen::Vector2d project(const Eigen::Vector3d& point) const;
+  Eigen::Vector3d lift(const Eigen::Vector2d& q) const { return origin + q.x() * u + q.y() * v; }
+  Eigen::Vector3d origin, u, v;
+};
+
 class PlaneExtent
 {
 public:
@@ -20,28 +30,31 @@ public:
   static constexpr size_t kMaxCells = 40000;    // 100 m^2 of plane
   static constexpr float kMaxWeight = 20.0f;
 
-  // Marks the cell under a world point that lies on the plane (normal, d).
-  void add(const Eigen::Vector3d& normal, double d, const Eigen::Vector3d& point);
-  // Every cell loses `amount`; empty cells are dropped, so the extent shrinks as a plane fades.
-  void decay(float amount);
-  // Convex hull of the cells, counter-clockwise about the normal, in the world frame.
-  std::vector<Eigen::Vector3d> hull(const Eigen::Vector3d& normal, double d) const;
+  // Marks the cell under a point (in plane coordinates) at frame `frame`.
+  void add(const Eigen::Vector2d& point, int64_t frame, float fade_per_frame);
+  // Drops cells that have faded out by `frame` (every cell loses fade_per_frame per frame
+  // since it was last seen), so the extent shrinks as a plane fades.
+  void sweep(int64_t frame, float fade_per_frame);
+  // Convex hull of the live cells, counter-clockwise about the normal, in the world frame.
+  std::vector<Eigen::Vector3d> hull(const PlaneBasis& basis, int64_t frame, float fade_per_frame) const;
   size_t cellCount() const { return cells_.size(); }
 
-  // For saving maps: cells as (x, y, weight).
-  std::vector<std::pair<std::pair<int32_t, int32_t>, float>> cells() const;
-  void setCell(int32_t x, int32_t y, float weight);
+  struct Cell
+  {
+    float weight;       // as of frame `seen`
+    int64_t seen;
+  };
+  // For saving maps: cells as ((x, y), cell).
+  std::vector<std::pair<std::pair<int32_t, int32_t>, Cell>> cells() const;
+  void setCell(int32_t x, int32_t y, const Cell& cell);
 
 private:
   static uint64_t key(int32_t x, int32_t y)
   {
     return (static_cast<uint64_t>(static_cast<uint32_t>(x)) << 32) | static_cast<uint32_t>(y);
   }
-  std::unordered_map<uint64_t, float> cells_;
+  static float weightAt(const Cell& c, int64_t frame, float fade) { return c.weight - fade * (frame - c.seen); }
+  std::unordered_map<uint64_t, Cell> cells_;
 };
-
-// In-plane axes (u, v) and origin of the plane n.p + d = 0, the same for the same plane.
-void planeBasis(const Eigen::Vector3d& normal, double d, Eigen::Vector3d& origin, Eigen::Vector3d& u,
-                Eigen::Vector3d& v);
 
 }  // namespace hough_plane_detector
