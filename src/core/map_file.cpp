@@ -101,8 +101,12 @@ std::string PlaneDetector::serializeMap() const
   std::sort(ids.begin(), ids.end());
   for (int id : ids)
   {
-    const auto cells = extents_.at(id).cells();
+    const PlaneExtent& extent = extents_.at(id);
+    const auto cells = extent.cells();
     w.put(static_cast<int32_t>(id));
+    const PlaneBasis basis = extent.basis() ? *extent.basis() : PlaneBasis(Eigen::Vector3d::UnitZ(), 0.0);
+    for (const Eigen::Vector3d* axis : {&basis.origin, &basis.u, &basis.v})
+      for (int i = 0; i < 3; ++i) w.put((*axis)(i));
     w.put(static_cast<uint32_t>(cells.size()));
     for (const auto& cell : cells)
     {
@@ -187,8 +191,13 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
   {
     int32_t id;
     uint32_t cell_count;
-    if (!r.get(id) || !r.get(cell_count) || cell_count > PlaneExtent::kMaxCells) return fail("map extents are truncated");
+    Eigen::Vector3d axes[3];
+    bool ok = r.get(id);
+    for (auto& axis : axes)
+      for (int i = 0; i < 3; ++i) ok = ok && r.get(axis(i));
+    if (!ok || !r.get(cell_count) || cell_count > PlaneExtent::kMaxCells) return fail("map extents are truncated");
     PlaneExtent& extent = extents[id];
+    extent.setBasis(PlaneBasis(axes[0], axes[1], axes[2]));
     for (uint32_t c = 0; c < cell_count; ++c)
     {
       int32_t x, y;

@@ -1,5 +1,6 @@
 #include "hough_plane_detector/core/normal_estimator.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
@@ -57,6 +58,14 @@ PointMoments PointMoments::transformed(const Eigen::Isometry3d& transform) const
   return m;
 }
 
+int blockSize(int window, int stride)
+{
+  // The largest divisor of the stride (so also of the window) that is at most 8.
+  for (int b = std::min(8, stride); b > 1; --b)
+    if (stride % b == 0) return b;
+  return 1;
+}
+
 double quantizationStep(double depth)
 {
   // Kinect disparity: f = 580 px, baseline 0.075 m, 1/8 px steps.
@@ -79,7 +88,9 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
 {
   samples.clear();
   valid_windows_ = 0;
-  const int s = config.stride;
+  // Blocks of at most 8 x 8 pixels carry the moments (the planarity tests downstream work on
+  // them); windows are k x k blocks placed every `step` blocks.
+  const int s = blockSize(config.window, config.stride);
   blocks_x_ = cloud.width / s;
   blocks_y_ = cloud.height / s;
   blocks_.assign(static_cast<size_t>(blocks_x_) * blocks_y_, PointMoments());
@@ -161,6 +172,7 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
 
   // Summed-area table over blocks: a window of k x k blocks costs four look-ups.
   const int k = config.window / s;
+  const int step = config.stride / s;
   const int ix = blocks_x_ + 1;
   if (k > 1) integral_.assign(static_cast<size_t>(ix) * (blocks_y_ + 1), PointMoments());
   for (int by = 0; by < blocks_y_ && k > 1; ++by)
@@ -179,9 +191,9 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
   const Eigen::Matrix3d rotation = camera_to_world.linear();
   const Eigen::Vector3d translation = camera_to_world.translation();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  for (int wy = 0; wy + k <= blocks_y_; ++wy)
+  for (int wy = 0; wy + k <= blocks_y_; wy += step)
   {
-    for (int wx = 0; wx + k <= blocks_x_; ++wx)
+    for (int wx = 0; wx + k <= blocks_x_; wx += step)
     {
       PointMoments m;
       if (k == 1)

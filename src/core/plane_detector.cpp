@@ -356,7 +356,7 @@ PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, do
                                               bool tight)
 {
   // Blocks covered by the windows, each once, whose points lie on the plane.
-  const int k = params_.normal_window / params_.normal_stride;
+  const int k = params_.normal_window / blockSize(params_.normal_window, params_.normal_stride);
   const int bx_count = normals_.blocksX();
   block_mark_.resize(static_cast<size_t>(bx_count) * normals_.blocksY(), 0);
   ++mark_generation_;
@@ -699,21 +699,21 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   // (lazily, swept every 16 frames); extents of planes that left the map go with them.
   const float fade = static_cast<float>(params_.thinning_rate);
   std::unordered_map<int, PlaneExtent> extents;
-  std::unordered_map<int, std::pair<PlaneExtent*, PlaneBasis>> by_id;
+  std::unordered_map<int, std::pair<PlaneExtent*, const DetectedPlane*>> by_id;
   for (const DetectedPlane& plane : planes_)
   {
     auto it = extents_.find(plane.id);
     PlaneExtent& extent = extents[plane.id];
     if (it != extents_.end()) extent = std::move(it->second);
     if (frame_count_ % 16 == 0) extent.sweep(frame_count_, fade);
-    by_id.emplace(plane.id, std::make_pair(&extent, PlaneBasis(plane.normal, plane.d)));
+    by_id.emplace(plane.id, std::make_pair(&extent, &plane));
   }
   for (size_t b = 0; b < block_labels_.size(); ++b)
   {
     if (block_labels_[b] < 0) continue;
     const auto& target = by_id.at(block_labels_[b]);
     const PointMoments& block = normals_.block(static_cast<int>(b) % normals_.blocksX(), static_cast<int>(b) / normals_.blocksX());
-    target.first->add(target.second.project(camera_to_world_ * block.mean()), frame_count_, fade);
+    target.first->add(camera_to_world_ * block.mean(), target.second->normal, target.second->d, frame_count_, fade);
   }
   extents_.swap(extents);
 }
@@ -732,14 +732,13 @@ const PlaneExtent* PlaneDetector::extent(int id) const
 std::vector<Eigen::Vector3d> PlaneDetector::hull(const DetectedPlane& plane) const
 {
   const PlaneExtent* e = extent(plane.id);
-  return e ? e->hull(PlaneBasis(plane.normal, plane.d), frame_count_, static_cast<float>(params_.thinning_rate))
-           : std::vector<Eigen::Vector3d>();
+  return e ? e->hull(frame_count_, static_cast<float>(params_.thinning_rate)) : std::vector<Eigen::Vector3d>();
 }
 
 void PlaneDetector::labelPixels(const CloudView& cloud, std::vector<int>& labels) const
 {
   labels.assign(cloud.size(), -1);
-  const int s = params_.normal_stride, bx_count = normals_.blocksX();
+  const int s = blockSize(params_.normal_window, params_.normal_stride), bx_count = normals_.blocksX();
   if (block_labels_.empty() || cloud.width / s != bx_count || cloud.height / s != normals_.blocksY()) return;
   std::unordered_map<int, std::pair<Eigen::Vector3d, double>> camera_planes;
   for (const DetectedPlane& plane : planes_)

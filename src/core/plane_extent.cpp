@@ -9,8 +9,7 @@ namespace hough_plane_detector
 
 PlaneBasis::PlaneBasis(const Eigen::Vector3d& normal, double d)
 {
-  // The world axis least aligned with the normal fixes u, so the basis does not spin with
-  // small changes of the normal.
+  // u from the world axis least aligned with the normal.
   Eigen::Index axis;
   normal.cwiseAbs().minCoeff(&axis);
   u = normal.cross(Eigen::Vector3d::Unit(axis)).normalized();
@@ -24,8 +23,11 @@ Eigen::Vector2d PlaneBasis::project(const Eigen::Vector3d& point) const
   return Eigen::Vector2d(q.dot(u), q.dot(v));
 }
 
-void PlaneExtent::add(const Eigen::Vector2d& point, int64_t frame, float fade)
+void PlaneExtent::add(const Eigen::Vector3d& world_point, const Eigen::Vector3d& normal, double d, int64_t frame,
+                      float fade)
 {
+  if (!basis_) basis_ = std::make_shared<const PlaneBasis>(normal, d);
+  const Eigen::Vector2d point = basis_->project(world_point);
   const int32_t x = static_cast<int32_t>(std::floor(point.x() / kCellSize));
   const int32_t y = static_cast<int32_t>(std::floor(point.y() / kCellSize));
   auto it = cells_.find(key(x, y));
@@ -51,8 +53,9 @@ void PlaneExtent::sweep(int64_t frame, float fade)
   }
 }
 
-std::vector<Eigen::Vector3d> PlaneExtent::hull(const PlaneBasis& basis, int64_t frame, float fade) const
+std::vector<Eigen::Vector3d> PlaneExtent::hull(int64_t frame, float fade) const
 {
+  if (!basis_) return {};
   // Only the outermost live cell of each row can be on the hull.
   std::map<int32_t, std::pair<int32_t, int32_t>> rows;
   for (const auto& cell : cells_)
@@ -95,7 +98,7 @@ std::vector<Eigen::Vector3d> PlaneExtent::hull(const PlaneBasis& basis, int64_t 
     chain[k++] = corners[i - 1];
   }
   chain.resize(k - 1);
-  for (const auto& c : chain) polygon.push_back(basis.lift(c));
+  for (const auto& c : chain) polygon.push_back(basis_->lift(c));
   return polygon;
 }
 

@@ -66,7 +66,7 @@ struct DetectorParams
 
   // Normal estimation: square window and stride in pixels; window must be a multiple of stride.
   int normal_window = 32;
-  int normal_stride = 8;
+  int normal_stride = 16;
   // Fraction of a window's pixels that must be valid for a normal.
   double min_valid_fraction = 0.6;
   // Windows whose curvature (smallest eigenvalue / trace) exceeds this are not planar.

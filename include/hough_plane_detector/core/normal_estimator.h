@@ -36,7 +36,7 @@ struct WindowSample
   Eigen::Vector3d centroid;  // world frame
   double d;                  // normal.p + d = 0
   int count;                 // valid points in the window
-  int window_x, window_y;    // window position in strides (top-left block)
+  int window_x, window_y;    // window position: its top-left block
 };
 
 struct NormalEstimatorConfig
@@ -49,6 +49,8 @@ struct NormalEstimatorConfig
   double sensor_noise = 1.0;
 };
 
+// Edge of the pixel blocks that carry point moments for a window and stride (<= 8 pixels).
+int blockSize(int window, int stride);
 // Depth step of a Kinect's 1/8-pixel disparity at depth z.
 double quantizationStep(double depth);
 // Expected depth noise (eq. 11 plus 1/8-pixel disparity quantization) of a Kinect at depth z.
@@ -61,7 +63,7 @@ public:
   void compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, const NormalEstimatorConfig& config,
                std::vector<WindowSample>& samples);
 
-  // Camera-frame moments of the block grid (stride x stride pixel blocks) of the last cloud.
+  // Camera-frame moments of the block grid (blockSize() pixel blocks) of the last cloud.
   int blocksX() const { return blocks_x_; }
   int blocksY() const { return blocks_y_; }
   const PointMoments& block(int bx, int by) const { return blocks_[static_cast<size_t>(by) * blocks_x_ + bx]; }

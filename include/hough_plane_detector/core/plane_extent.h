@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -18,6 +19,10 @@ namespace hough_plane_detector
 struct PlaneBasis
 {
   PlaneBasis(const Eigen::Vector3d& normal, double d);
+  PlaneBasis(const Eigen::Vector3d& origin, const Eigen::Vector3d& u, const Eigen::Vector3d& v)
+    : origin(origin), u(u), v(v)
+  {
+  }
   Eigen::Vector2d project(const Eigen::Vector3d& point) const;
   Eigen::Vector3d lift(const Eigen::Vector2d& q) const { return origin + q.x() * u + q.y() * v; }
   Eigen::Vector3d origin, u, v;
@@ -30,13 +35,15 @@ public:
   static constexpr size_t kMaxCells = 40000;    // 100 m^2 of plane
   static constexpr float kMaxWeight = 20.0f;
 
-  // Marks the cell under a point (in plane coordinates) at frame `frame`.
-  void add(const Eigen::Vector2d& point, int64_t frame, float fade_per_frame);
+  // Marks the cell under a world point of the plane (normal, d) at frame `frame`. The first
+  // call fixes the extent's own 2-D basis: a basis recomputed from each new estimate of the
+  // normal could turn, and the cells with it.
+  void add(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double d, int64_t frame, float fade_per_frame);
   // Drops cells that have faded out by `frame` (every cell loses fade_per_frame per frame
   // since it was last seen), so the extent shrinks as a plane fades.
   void sweep(int64_t frame, float fade_per_frame);
   // Convex hull of the live cells, counter-clockwise about the normal, in the world frame.
-  std::vector<Eigen::Vector3d> hull(const PlaneBasis& basis, int64_t frame, float fade_per_frame) const;
+  std::vector<Eigen::Vector3d> hull(int64_t frame, float fade_per_frame) const;
   size_t cellCount() const { return cells_.size(); }
 
   struct Cell
@@ -47,6 +54,8 @@ public:
   // For saving maps: cells as ((x, y), cell).
   std::vector<std::pair<std::pair<int32_t, int32_t>, Cell>> cells() const;
   void setCell(int32_t x, int32_t y, const Cell& cell);
+  const PlaneBasis* basis() const { return basis_.get(); }
+  void setBasis(const PlaneBasis& basis) { basis_.reset(new PlaneBasis(basis)); }
 
 private:
   static uint64_t key(int32_t x, int32_t y)
@@ -55,6 +64,7 @@ private:
   }
   static float weightAt(const Cell& c, int64_t frame, float fade) { return c.weight - fade * (frame - c.seen); }
   std::unordered_map<uint64_t, Cell> cells_;
+  std::shared_ptr<const PlaneBasis> basis_;
 };
 
 }  // namespace hough_plane_detector
