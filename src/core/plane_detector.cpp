@@ -549,7 +549,8 @@ void PlaneDetector::findLocalPeaks()
         moments = PointMoments();
         break;
       }
-      collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
+      moments = collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
+      if (moments.count < std::max(3, params_.min_support)) break;
       moments = keepFlatComponents(blocks);
       if (moments.count < std::max(3, params_.min_support)) break;
       const PointMoments world = weightedMoments(blocks).transformed(camera_to_world_);
@@ -557,8 +558,12 @@ void PlaneDetector::findLocalPeaks()
       solver.computeDirect(world.covariance());
       Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
       if (n.dot(normal) < 0.0) n = -n;
+      const double d_new = -n.dot(world.mean());
+      // Converged: another pass would select the same windows and blocks.
+      const bool converged = pass > 0 && unsignedAngle(n, normal) < 2e-4 && std::abs(d_new - d) < 5e-4;
       normal = n;
-      d = -n.dot(world.mean());
+      d = d_new;
+      if (converged) break;
     }
     if (moments.count < std::max(3, params_.min_support)) continue;
     if (!isPlanarFit(weightedMoments(blocks), blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;

@@ -50,7 +50,7 @@ struct DetectorParams
   int peak_window = 5;
 
   // Minimum blurred value of a local (per-frame) peak; roughly points voting for one cell.
-  double local_threshold = 150.0;
+  double local_threshold = 500.0;
   // Minimum number of points in the frame that lie on a local peak's plane for it to be kept.
   int min_support = 800;
   // Minimum global value (about the number of frames that saw the plane) to report a plane.
