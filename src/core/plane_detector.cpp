@@ -713,12 +713,18 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
     if (frame_count_ % 16 == 0) extent.sweep(frame_count_, fade);
     by_id.emplace(plane.id, std::make_pair(&extent, &plane));
   }
+  int last_id = -1;
+  const std::pair<PlaneExtent*, const DetectedPlane*>* target = nullptr;
   for (size_t b = 0; b < block_labels_.size(); ++b)
   {
     if (block_labels_[b] < 0) continue;
-    const auto& target = by_id.at(block_labels_[b]);
-    const PointMoments& block = normals_.block(static_cast<int>(b) % normals_.blocksX(), static_cast<int>(b) / normals_.blocksX());
-    target.first->add(camera_to_world_ * block.mean(), target.second->normal, target.second->d, frame_count_, fade);
+    if (block_labels_[b] != last_id)  // neighbouring blocks mostly share a plane
+    {
+      last_id = block_labels_[b];
+      target = &by_id.at(last_id);
+    }
+    const Eigen::Vector3d centroid = camera_to_world_ * block_info_[b].centroid;
+    target->first->add(centroid, target->second->normal, target->second->d, frame_count_, fade);
   }
   extents_.swap(extents);
 }

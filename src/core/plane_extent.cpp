@@ -30,13 +30,10 @@ void PlaneExtent::add(const Eigen::Vector3d& world_point, const Eigen::Vector3d&
   const Eigen::Vector2d point = basis_->project(world_point);
   const int32_t x = static_cast<int32_t>(std::floor(point.x() / kCellSize));
   const int32_t y = static_cast<int32_t>(std::floor(point.y() / kCellSize));
-  auto it = cells_.find(key(x, y));
-  if (it == cells_.end())
-  {
-    if (cells_.size() >= kMaxCells) return;  // bounded memory
-    cells_.emplace(key(x, y), Cell{1.0f, frame});
-    return;
-  }
+  if (cells_.size() >= kMaxCells && cells_.find(key(x, y)) == cells_.end()) return;  // bounded memory
+  const auto inserted = cells_.try_emplace(key(x, y), Cell{1.0f, frame});
+  if (inserted.second) return;
+  const auto it = inserted.first;
   // Fading is applied lazily: a cell's weight is brought up to date when it is touched.
   it->second.weight = std::min(kMaxWeight, std::max(0.0f, weightAt(it->second, frame, fade)) + 1.0f);
   it->second.seen = frame;
