@@ -50,6 +50,11 @@ std::string describe(const std::vector<DetectedPlane>& planes)
 
 TEST(PlaneDetector, RefusesInvalidParameters)
 {
+  DetectorParams zero_step;
+  zero_step.resolution = 0;
+  zero_step.d_step = 0.0;  // would size the Hough space at infinity
+  EXPECT_THROW(PlaneDetector{zero_step}, std::invalid_argument);
+
   DetectorParams params;
   params.normal_window = 12;
   params.normal_stride = 8;

@@ -32,6 +32,14 @@ double unsignedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
   return std::acos(std::min(1.0, std::abs(a.dot(b))));
 }
 
+// Throws before any member is built from bad values (a zero step would size the space at infinity).
+const DetectorParams& validated(const DetectorParams& params)
+{
+  const std::string problem = params.validate();
+  if (!problem.empty()) throw std::invalid_argument("invalid detector parameters: " + problem);
+  return params;
+}
+
 bool isFiniteTransform(const Eigen::Isometry3d& t)
 {
   if (!t.matrix().allFinite()) return false;
@@ -41,13 +49,11 @@ bool isFiniteTransform(const Eigen::Isometry3d& t)
 }  // namespace
 
 PlaneDetector::PlaneDetector(const DetectorParams& params)
-  : params_(params)
+  : params_(validated(params))
   , param_(params.effectiveAngleStep(), params.effectiveDStep(), params.max_distance, marginCells(params))
   , local_(param_.sizeAngle(), param_.sizeAngle(), param_.sizeD())
   , global_(param_.sizeAngle(), param_.sizeAngle(), param_.sizeD())
 {
-  const std::string problem = params.validate();
-  if (!problem.empty()) throw std::invalid_argument("invalid detector parameters: " + problem);
   blur_radius_ = params_.blur_kernel_size / 2;
   peak_radius_ = params_.peak_window / 2;
   // Precomputed once (paper 3.3.2); maximum 1, so a lone vote of weight w blurs to peak w.
@@ -728,11 +734,6 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   }
   extents_.swap(extents);
 }
-
-}  // namespace hough_plane_detector
-
-namespace hough_plane_detector
-{
 
 const PlaneExtent* PlaneDetector::extent(int id) const
 {
