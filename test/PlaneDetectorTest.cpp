@@ -352,6 +352,12 @@ TEST(PlaneDetector, BadInputIsRefusedAndLeavesTheMapUntouched)
   EXPECT_FALSE(detector.processFrame(tiny, frame.camera_to_world, 4, &error));
   EXPECT_NE(error.find("smaller than one normal window"), std::string::npos) << error;
   EXPECT_FALSE(detector.processFrame(CloudView(), frame.camera_to_world, 4, &error));
+  CloudView unorganized = frame.view();
+  unorganized.width = 640 * 480;
+  unorganized.height = 1;
+  unorganized.row_step = unorganized.point_step * unorganized.width;
+  EXPECT_FALSE(detector.processFrame(unorganized, frame.camera_to_world, 4, &error));
+  EXPECT_NE(error.find("unorganized"), std::string::npos) << error;
 
   ASSERT_EQ(detector.planes().size(), before.size());
   for (size_t i = 0; i < before.size(); ++i)

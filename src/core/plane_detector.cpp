@@ -95,6 +95,9 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
   if (!cloud.data || cloud.width <= 0 || cloud.height <= 0) return fail("cloud is empty");
   if (!isFiniteTransform(camera_to_world)) return fail("camera-to-world transform is not a finite rigid transform");
   if (!std::isfinite(stamp)) return fail("stamp is not finite");
+  if (cloud.height == 1)
+    return fail("cloud is unorganized (height 1, width " + std::to_string(cloud.width) +
+                "): normals come from image windows, so an organized depth cloud (width x height) is needed");
   if (cloud.width < params_.normal_window || cloud.height < params_.normal_window)
     return fail("cloud of " + std::to_string(cloud.width) + " x " + std::to_string(cloud.height) +
                 " is smaller than one normal window of " + std::to_string(params_.normal_window) + " pixels");
