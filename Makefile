@@ -7,7 +7,7 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all deps build test demo demo-offline bench clean
+.PHONY: all deps build test fuzz demo demo-offline bench clean
 
 all: build
 
@@ -26,7 +26,13 @@ test: build
 	@rm -rf $(WS)/build/test_results
 	@catkin_make -C $(WS) run_tests > $(WS)/run_tests.log 2>&1 || true
 	@grep -E "^\[ *(RUN|OK|FAILED|PASSED) *\]|Failure|error:" $(WS)/run_tests.log | grep -v "^\[ *RUN" || true
+	@scripts/run_fuzzers.sh smoke $(CURDIR)/$(WS)/build/test_results/fuzz || true
 	@scripts/test_summary.py $(WS)/build/test_results
+
+# libFuzzer on the cloud conversion and the map loader, FUZZ_SECONDS per target.
+FUZZ_SECONDS ?= 300
+fuzz: deps
+	scripts/run_fuzzers.sh long $(FUZZ_SECONDS)
 
 # The whole ROS path for about 20 s (simulated Kinect -> detector nodelet), then the map against
 # the truth and a picture; roslaunch starts its own master when none runs.

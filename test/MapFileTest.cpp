@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 
 #include "hough_plane_detector/core/plane_detector.h"
@@ -126,6 +127,27 @@ TEST(MapFile, RefusesBrokenOrForeignFilesAndKeepsTheCurrentMap)
 
   EXPECT_TRUE(target.deserializeMap(good, &error)) << error;
   EXPECT_EQ(target.planes().size(), source.planes().size());
+}
+
+// Found by fuzz_map_file: a count far beyond the file's size made the loader allocate for it
+// before reading (out of memory). Counts are now checked against the bytes left.
+TEST(MapFile, AbsurdCountsAreRefusedBeforeAllocating)
+{
+  PlaneDetector detector{DetectorParams()};
+  warmUp(detector, 2);
+  std::string body = detector.serializeMap();
+  body.resize(body.size() - sizeof(uint64_t));  // without its checksum
+  // magic 8, version 4, three doubles, two int32, next id int32, frame count int64: plane count at 56.
+  const size_t plane_count_offset = 8 + 4 + 3 * 8 + 2 * 4 + 4 + 8;
+  std::string error;
+  std::string absurd = body;
+  const uint32_t huge = 0xFFFFFFFFu;
+  std::memcpy(&absurd[plane_count_offset], &huge, sizeof(huge));
+  PlaneDetector target{DetectorParams()};
+  EXPECT_FALSE(target.deserializeMap(PlaneDetector::withMapChecksum(absurd), &error));
+  EXPECT_NE(error.find("plane count does not fit"), std::string::npos) << error;
+  // The unchanged body with its checksum still loads.
+  EXPECT_TRUE(target.deserializeMap(PlaneDetector::withMapChecksum(body), &error)) << error;
 }
 
 TEST(MapFile, SavingToAnUnwritablePlaceFailsCleanly)

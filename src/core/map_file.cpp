@@ -56,6 +56,7 @@ public:
     return true;
   }
   size_t position() const { return pos_; }
+  size_t remaining() const { return end_ - pos_; }
 
 private:
   const std::string& bytes_;
@@ -63,6 +64,14 @@ private:
   size_t pos_ = 0;
 };
 }  // namespace
+
+std::string PlaneDetector::withMapChecksum(const std::string& bytes)
+{
+  Writer w;
+  w.bytes = bytes;
+  w.put(fnv1a(bytes.data(), bytes.size()));
+  return w.bytes;
+}
 
 std::string PlaneDetector::serializeMap() const
 {
@@ -116,8 +125,7 @@ std::string PlaneDetector::serializeMap() const
       w.put(cell.second.seen);
     }
   }
-  w.put(fnv1a(w.bytes.data(), w.bytes.size()));
-  return w.bytes;
+  return withMapChecksum(w.bytes);
 }
 
 bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
@@ -160,6 +168,9 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
          << ", max_distance " << param_.maxDistance() << ", blur and peak windows as configured";
     return fail(what.str());
   }
+  // Counts are checked against the bytes left before anything is allocated for them.
+  constexpr size_t kPlaneBytes = 4 + 3 * 8 + 8 + 8 + 4 + 8 + 8 + 3 * 8;
+  if (plane_count > r.remaining() / kPlaneBytes) return fail("map plane count does not fit the file (truncated?)");
   std::vector<DetectedPlane> planes(plane_count);
   for (DetectedPlane& p : planes)
   {
@@ -174,6 +185,8 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
   }
   uint32_t chunk_count;
   if (!r.get(chunk_count)) return fail("map chunk list is truncated");
+  constexpr size_t kChunkBytes = 4 + sizeof(float) * SparseHoughSpace::kChunkCells;
+  if (chunk_count > r.remaining() / kChunkBytes) return fail("map chunk count does not fit the file (truncated?)");
   const size_t top_level = global_.topLevelCount();
   std::vector<std::pair<int32_t, std::vector<float>>> chunks(chunk_count);
   for (auto& chunk : chunks)

@@ -104,6 +104,8 @@ public:
   // Replaces the state by a serialized one; on any problem (foreign or truncated data, wrong
   // version or checksum, another grid) returns false with `error` set and changes nothing.
   bool deserializeMap(const std::string& bytes, std::string* error);
+  // `bytes` with the checksum a map file ends with appended (for tools and fuzzing).
+  static std::string withMapChecksum(const std::string& bytes);
   // File versions: saving writes FILE.tmp and renames it, so a crash never leaves half a map.
   bool saveMap(const std::string& path, std::string* error) const;
   bool loadMap(const std::string& path, std::string* error);
