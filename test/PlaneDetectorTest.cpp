@@ -375,6 +375,26 @@ TEST(PlaneDetector, BadInputIsRefusedAndLeavesTheMapUntouched)
   EXPECT_EQ(detector.lastStats().samples, 0);
 }
 
+TEST(PlaneDetector, AChunkCapBoundsMemoryAndKeepsTheMainPlanes)
+{
+  DetectorParams params;
+  params.max_chunks = 24;  // the office tour needs about 40 without a cap
+  PlaneDetector detector(params);
+  SceneRenderer renderer(makeOfficeRoom());
+  const auto poses = roomTour(40);
+  size_t evicted = 0;
+  for (size_t f = 0; f < poses.size(); ++f)
+  {
+    feed(detector, renderer.render(poses[f], kinect(1.0), 300 + f), f);
+    EXPECT_LE(detector.memory().global_chunks, 24u) << "frame " << f;
+    evicted += detector.lastStats().chunks_evicted;
+  }
+  EXPECT_GT(evicted, 0u) << "the cap never bit: the test does not test it";
+  EXPECT_EQ(detector.memory().chunks_evicted_total, evicted);
+  EXPECT_EQ(matching(detector.planes(), kZ, 0.0, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+  EXPECT_EQ(matching(detector.planes(), kX, -3.0, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+}
+
 TEST(PlaneDetector, HoughSpaceOfABigRoomStaysUnderOnePercentOfTheDenseArray)
 {
   // 10 x 10 x 3 m with four walls, floor, ceiling and 16 boxes: 80+ planes.

@@ -87,3 +87,20 @@ TEST(SparseHoughSpace, ThinningDecaysFreesEmptyChunksAndKeepsPermanentCells)
   EXPECT_EQ(space.chunkCount(), 0u);
   EXPECT_EQ(space.value(40, 40, 40), 0.0f);
 }
+
+TEST(SparseHoughSpace, EvictingKeepsTheStrongestChunks)
+{
+  SparseHoughSpace space(64, 64, 64);
+  space.add(1, 1, 1, 0.5f);     // chunk (0,0,0): weakest
+  space.add(20, 1, 1, 3.0f);    // chunk (1,0,0)
+  space.add(40, 1, 1, 1.0f);    // chunk (2,0,0)
+  space.add(1, 20, 1, 9.0f);    // chunk (0,1,0): strongest
+  ASSERT_EQ(space.chunkCount(), 4u);
+  EXPECT_EQ(space.evictWeakest(4), 0u);
+  EXPECT_EQ(space.evictWeakest(2), 2u);
+  EXPECT_EQ(space.chunkCount(), 2u);
+  EXPECT_EQ(space.value(1, 1, 1), 0.0f);
+  EXPECT_EQ(space.value(40, 1, 1), 0.0f);
+  EXPECT_FLOAT_EQ(space.value(20, 1, 1), 3.0f);
+  EXPECT_FLOAT_EQ(space.value(1, 20, 1), 9.0f);
+}

@@ -64,6 +64,7 @@ PlaneDetector::PlaneDetector(const DetectorParams& params)
 
 void PlaneDetector::reset()
 {
+  chunks_evicted_total_ = 0;
   extents_.clear();
   frame_count_ = 0;
   global_.clear();
@@ -82,6 +83,7 @@ MemoryReport PlaneDetector::memory() const
   report.local_bytes = local_.bytesUsed();
   report.dense_bytes = global_.denseBytes();
   report.top_level_cells = global_.topLevelCount();
+  report.chunks_evicted_total = chunks_evicted_total_;
   return report;
 }
 
@@ -631,6 +633,8 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
     seeds.push_back(cellOf(peak.hough));
   }
   for (const DetectedPlane& plane : planes_) seeds.push_back(cellOf(plane.hough));
+  stats_.chunks_evicted = static_cast<int>(global_.evictWeakest(static_cast<size_t>(params_.max_chunks)));
+  chunks_evicted_total_ += stats_.chunks_evicted;
 
   std::vector<Peak> peaks = mergeSimilar(extractPeaks(global_, seeds, params_.global_threshold));
 

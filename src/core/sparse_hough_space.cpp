@@ -93,6 +93,33 @@ void SparseHoughSpace::thin(float rate, float cap)
   allocated_.swap(kept);
 }
 
+size_t SparseHoughSpace::evictWeakest(size_t max_chunks)
+{
+  if (allocated_.size() <= max_chunks) return 0;
+  std::vector<std::pair<float, int>> strength;
+  strength.reserve(allocated_.size());
+  for (int chunk_index : allocated_)
+  {
+    const float* chunk = chunks_[chunk_index].get();
+    strength.emplace_back(*std::max_element(chunk, chunk + kChunkCells), chunk_index);
+  }
+  const size_t evicted = allocated_.size() - max_chunks;
+  std::nth_element(strength.begin(), strength.begin() + evicted, strength.end());
+  std::vector<char> drop(chunks_.size(), 0);
+  for (size_t i = 0; i < evicted; ++i) drop[strength[i].second] = 1;
+  std::vector<int> kept;
+  kept.reserve(max_chunks);
+  for (int chunk_index : allocated_)
+  {
+    if (drop[chunk_index])
+      release(chunk_index);
+    else
+      kept.push_back(chunk_index);
+  }
+  allocated_.swap(kept);
+  return evicted;
+}
+
 void SparseHoughSpace::clear()
 {
   for (int chunk_index : allocated_) release(chunk_index);

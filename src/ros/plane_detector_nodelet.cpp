@@ -293,6 +293,8 @@ private:
       rate = (arrivals_.size() - 1) / std::max(1e-6, (arrivals_.back() - arrivals_.front()).toSec());
     if (frames_processed_ == 0)
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no cloud processed yet");
+    else if (memory.chunks_evicted_total > 0)
+      status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "the max_chunks cap freed Hough chunks");
     else if (frames_dropped_ + frames_rejected_ + frames_queue_dropped_ > 0)
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "some clouds were skipped");
     else
@@ -307,6 +309,7 @@ private:
     status.add("Hough space MB", memory.global_bytes / 1e6);
     status.add("Hough space % of dense", 100.0 * memory.global_bytes / std::max<size_t>(1, memory.dense_bytes));
     status.add("Hough chunks", memory.global_chunks);
+    status.add("Hough chunks freed by max_chunks", memory.chunks_evicted_total);
     const HoughParameterization& grid = detector_->parameterization();
     status.addf("Hough grid", "resolution %d: %d x %d x %d cells", params_.resolution, grid.sizeAngle(), grid.sizeAngle(),
                 grid.sizeD());

@@ -18,6 +18,7 @@
   X(double, global_threshold)          \
   X(double, thinning_rate)             \
   X(double, permanence_cap)            \
+  X(int, max_chunks)                   \
   X(double, merge_angle)               \
   X(double, merge_distance)            \
   X(int, normal_window)                \
@@ -59,6 +60,8 @@ struct DetectorParams
   double thinning_rate = 0.05;
   // Global cells reaching this value become permanent and stop thinning.
   double permanence_cap = 20.0;
+  // Most 16^3 chunks (16 kB each) the global space may hold; beyond it the weakest are freed.
+  int max_chunks = 8192;
 
   // Planes closer than both merge thresholds are one plane (eq. 7-10).
   double merge_angle = 0.05;

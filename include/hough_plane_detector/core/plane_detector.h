@@ -45,6 +45,7 @@ struct MemoryReport
   size_t local_bytes = 0;       // per-frame space, as allocated in the last frame
   size_t dense_bytes = 0;       // a dense float array of the same grid
   size_t top_level_cells = 0;
+  size_t chunks_evicted_total = 0;  // freed by the max_chunks cap since the map began
 };
 
 struct FrameStats
@@ -54,6 +55,7 @@ struct FrameStats
   int votes_out_of_range = 0;
   int cache_cells = 0;       // distinct cells of the unblurred cache space
   int local_peaks = 0;       // local peaks kept for the global space
+  int chunks_evicted = 0;    // global chunks freed by the max_chunks cap in this frame
 };
 
 class PlaneDetector
@@ -184,7 +186,8 @@ private:
   std::vector<Peak> local_peaks_;
   std::vector<DetectedPlane> planes_;
   std::unordered_map<int, PlaneExtent> extents_;
-  int64_t frame_count_ = 0;  // frames processed since the map began (extents fade by it)
+  int64_t frame_count_ = 0;
+  size_t chunks_evicted_total_ = 0;  // frames processed since the map began (extents fade by it)
   int next_id_ = 0;
   StageTimings timings_;
   FrameStats stats_;

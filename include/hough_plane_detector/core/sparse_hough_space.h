@@ -44,6 +44,9 @@ public:
 
   // Subtracts `rate` from every cell below `cap` (never below 0) and frees chunks left empty.
   void thin(float rate, float cap);
+  // Frees the chunks whose largest value is smallest until at most max_chunks remain; returns
+  // how many were freed (a memory cap for long runs: the weakest evidence goes first).
+  size_t evictWeakest(size_t max_chunks);
   // Frees every chunk (kept in a pool for reuse, which is not counted as used memory).
   void clear();
 
