@@ -7,7 +7,7 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all deps build test fuzz demo demo-offline bench clean
+.PHONY: all deps build test fuzz soak demo demo-offline bench clean
 
 all: build
 
@@ -45,6 +45,14 @@ demo-offline: build
 
 bench: build
 	$(BIN)/benchmark_detector $(REAL_FRAMES)
+
+# 10,000 simulated frames through one detector: resident memory, chunks, planes, ms; then
+# valgrind's leak check over a short run.
+SOAK_FRAMES ?= 10000
+soak: build
+	$(BIN)/soak_detector $(SOAK_FRAMES)
+	@command -v valgrind > /dev/null && valgrind --leak-check=full --errors-for-leak-kinds=definite \
+	  --error-exitcode=3 $(BIN)/soak_detector 60 2>&1 | grep -E "definitely lost|no leaks are possible|ERROR SUMMARY" || true
 
 clean:
 	rm -rf build
