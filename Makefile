@@ -1,7 +1,24 @@
 # One-command entry points; each installs missing Debian packages first and is safe to rerun.
 SHELL := /bin/bash
-WS := build/ws
 PKG := hough_plane_detector
+# make test SANITIZE=address,undefined: the same tests, built with sanitizers in their own
+# workspace; the ROS tests load the instrumented nodelets into the (uninstrumented) nodelet
+# manager, so the sanitizer runtime is preloaded there, leak checks stay on the gtest binaries.
+SANITIZE ?=
+ifeq ($(SANITIZE),)
+WS := build/ws
+CMAKE_ARGS := -DCMAKE_BUILD_TYPE=Release
+TEST_ENV :=
+else
+WS := build/ws-sanitize
+SAN := -fsanitize=$(SANITIZE)
+CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
+  "-DCMAKE_EXE_LINKER_FLAGS=$(SAN)" "-DCMAKE_SHARED_LINKER_FLAGS=$(SAN)"
+SAN_RUNTIMES := $(if $(findstring address,$(SANITIZE)),$(shell gcc -print-file-name=libasan.so)) \
+  $(if $(findstring undefined,$(SANITIZE)),$(shell gcc -print-file-name=libubsan.so))
+TEST_ENV := ASAN_OPTIONS=detect_leaks=0:verify_asan_link_order=0 UBSAN_OPTIONS=print_stacktrace=1 \
+  HOUGH_PLANE_DETECTOR_HZ_ERROR=9.5 LD_PRELOAD="$(strip $(SAN_RUNTIMES))"
+endif
 BIN := $(WS)/devel/lib/$(PKG)
 REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
@@ -20,13 +37,15 @@ build: deps
 	@if [ -L $(WS)/src/$(PKG) ]; then rm $(WS)/src/$(PKG); fi
 	@mkdir -p $(WS)/src/$(PKG)
 	@for f in $$(ls -A | grep -vxE 'build|\.git'); do ln -sfn $(CURDIR)/$$f $(WS)/src/$(PKG)/$$f; done
-	catkin_make -C $(WS) -DCMAKE_BUILD_TYPE=Release
+	catkin_make -C $(WS) $(CMAKE_ARGS)
 
 test: build
 	@rm -rf $(WS)/build/test_results
-	@catkin_make -C $(WS) run_tests > $(WS)/run_tests.log 2>&1 || true
-	@grep -E "^\[ *(RUN|OK|FAILED|PASSED) *\]|Failure|error:" $(WS)/run_tests.log | grep -v "^\[ *RUN" || true
-	@scripts/run_fuzzers.sh smoke $(CURDIR)/$(WS)/build/test_results/fuzz || true
+	@catkin_make -C $(WS) tests > $(WS)/build_tests.log 2>&1 || { tail -30 $(WS)/build_tests.log; false; }
+	@$(TEST_ENV) catkin_make -C $(WS) run_tests > $(WS)/run_tests.log 2>&1 || true
+	@grep -E "^\[ *(RUN|OK|FAILED|PASSED) *\]|Failure|error:|runtime error|ERROR: AddressSanitizer" $(WS)/run_tests.log | grep -v "^\[ *RUN" || true
+	@if [ -n "$(SANITIZE)" ]; then scripts/run_sanitized_gtests.sh $(CURDIR)/$(WS); fi
+	@if [ -z "$(SANITIZE)" ]; then scripts/run_fuzzers.sh smoke $(CURDIR)/$(WS)/build/test_results/fuzz || true; fi
 	@scripts/test_summary.py $(WS)/build/test_results
 
 # libFuzzer on the cloud conversion and the map loader, FUZZ_SECONDS per target.
