@@ -116,13 +116,31 @@ private:
     tf_filter_->setTolerance(ros::Duration(tf_tolerance));
     tf_filter_->registerCallback(boost::bind(&PlaneDetectorNodelet::cloudCallback, this, boost::placeholders::_1));
     tf_filter_->registerFailureCallback(boost::bind(&PlaneDetectorNodelet::failureCallback, this, boost::placeholders::_1, boost::placeholders::_2));
+    // tf2's filter holds a cloud of a frame tf has never heard of until newer such clouds push it
+    // out of the queue; say so at arrival instead.
+    subscriber_->registerCallback(boost::bind(&PlaneDetectorNodelet::checkFrameKnown, this, boost::placeholders::_1));
     NODELET_INFO("Detecting planes in %s (world frame %s), resolution %d.", subscriber_->getTopic().c_str(),
                  world_frame_.c_str(), params_.resolution);
+  }
+
+  bool frameUnknown(const std::string& frame) const
+  {
+    return !frame.empty() && frame != world_frame_ && !tf_buffer_->_frameExists(frame);
+  }
+
+  void checkFrameKnown(const sensor_msgs::PointCloud2ConstPtr& cloud)
+  {
+    if (!frameUnknown(cloud->header.frame_id)) return;
+    std::lock_guard<std::mutex> lock(map_mutex_);
+    ++frames_dropped_;
+    NODELET_WARN_THROTTLE(5.0, "Cloud skipped: no transform from '%s' to '%s': tf has never seen frame '%s'.",
+                          cloud->header.frame_id.c_str(), world_frame_.c_str(), cloud->header.frame_id.c_str());
   }
 
   void failureCallback(const sensor_msgs::PointCloud2ConstPtr& cloud,
                        tf2_ros::filter_failure_reasons::FilterFailureReason reason)
   {
+    if (frameUnknown(cloud->header.frame_id)) return;  // counted and reported at arrival
     std::lock_guard<std::mutex> lock(map_mutex_);
     ++frames_dropped_;
     NODELET_WARN_THROTTLE(5.0, "Cloud skipped: no transform from '%s' to '%s' at %.3f (%s).",
