@@ -93,6 +93,17 @@ bool hasRoomPlanes(const PlaneArray& array, double angle_tol, double d_tol)
   return true;
 }
 
+// A reconfigure request that sets one integer parameter.
+dynamic_reconfigure::Reconfigure setInt(const std::string& name, int value)
+{
+  dynamic_reconfigure::Reconfigure srv;
+  dynamic_reconfigure::IntParameter parameter;
+  parameter.name = name;
+  parameter.value = value;
+  srv.request.config.ints.push_back(parameter);
+  return srv;
+}
+
 template <class Srv>
 Srv call(const std::string& name, Srv srv)
 {
@@ -210,12 +221,7 @@ TEST(Pipeline, SaveResetLoadRestoresTheMap)
 
 TEST(Pipeline, ReconfiguringTheResolutionRebuildsTheSpaceAndBadValuesAreRefused)
 {
-  dynamic_reconfigure::Reconfigure srv;
-  dynamic_reconfigure::IntParameter resolution;
-  resolution.name = "resolution";
-  resolution.value = 512;
-  srv.request.config.ints.push_back(resolution);
-  srv = call(kNode + "/set_parameters", srv);
+  const dynamic_reconfigure::Reconfigure srv = call(kNode + "/set_parameters", setInt("resolution", 512));
   bool applied = false;
   for (const auto& p : srv.response.config.ints) applied = applied || (p.name == "resolution" && p.value == 512);
   EXPECT_TRUE(applied);
@@ -228,12 +234,7 @@ TEST(Pipeline, ReconfiguringTheResolutionRebuildsTheSpaceAndBadValuesAreRefused)
   })) << "diagnostics never showed the 512 grid";
 
   // A window that is not a multiple of the stride is refused: the server answers with the old value.
-  dynamic_reconfigure::Reconfigure bad;
-  dynamic_reconfigure::IntParameter window;
-  window.name = "normal_window";
-  window.value = 12;
-  bad.request.config.ints.push_back(window);
-  bad = call(kNode + "/set_parameters", bad);
+  const dynamic_reconfigure::Reconfigure bad = call(kNode + "/set_parameters", setInt("normal_window", 12));
   for (const auto& p : bad.response.config.ints)
     if (p.name == "normal_window") EXPECT_EQ(p.value, 32);
 }

@@ -540,7 +540,7 @@ void PlaneDetector::findLocalPeaks()
   {
     Eigen::Vector3d normal = peak.normal;
     double d = peak.d;
-    PointMoments moments;
+    PointMoments moments, weighted;  // weighted: of the final blocks, reused by the planarity test
     for (int pass = 0; pass < 3; ++pass)
     {
       windows.clear();
@@ -564,7 +564,8 @@ void PlaneDetector::findLocalPeaks()
       if (moments.count < std::max(3, params_.min_support)) break;
       moments = keepFlatComponents(blocks);
       if (moments.count < std::max(3, params_.min_support)) break;
-      const PointMoments world = weightedMoments(blocks).transformed(camera_to_world_);
+      weighted = weightedMoments(blocks);
+      const PointMoments world = weighted.transformed(camera_to_world_);
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
       solver.computeDirect(world.covariance());
       Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
@@ -577,7 +578,7 @@ void PlaneDetector::findLocalPeaks()
       if (converged) break;
     }
     if (moments.count < std::max(3, params_.min_support)) continue;
-    if (!isPlanarFit(weightedMoments(blocks), blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;
+    if (!isPlanarFit(weighted, blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;
     // Claim everything within support_distance, not just the tight fit, so that leftovers
     // around an accepted plane cannot pose as a slightly tilted second one.
     for (int s : windows) claimed[s] = 1;
