@@ -24,7 +24,7 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all deps build test fuzz soak demo demo-offline bench clean
+.PHONY: all deps build test fuzz soak demo demo-offline bench evaluate clean
 
 all: build
 
@@ -64,6 +64,14 @@ demo-offline: build
 
 bench: build
 	$(BIN)/benchmark_detector $(REAL_FRAMES)
+
+# The paper's experiments (Fig. 6, 7, 8, Table 3, timing) with PCL's methods on the same frames:
+# docs/RESULTS.md and docs/results/*.png; QUICK=1 is a short run into build/evaluate-quick.
+QUICK ?=
+EVALUATE_DIR := $(if $(QUICK),build/evaluate-quick,docs)
+evaluate: build
+	@scripts/install_deps.sh gnuplot-nox
+	@scripts/evaluate.sh $(BIN) $(EVALUATE_DIR) $(if $(QUICK),1,0) $(REAL_FRAMES)
 
 # 10,000 simulated frames through one detector: resident memory, chunks, planes, ms; then
 # valgrind's leak check over a short run.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the build, the tests and the demo need; does nothing when all
-# are present, so it is safe to run any number of times.
+# are present, so it is safe to run any number of times. Usage: install_deps.sh [EXTRA_PACKAGE ...]
 set -euo pipefail
 packages=(
   build-essential cmake catkin ros-message-generation libroscpp-dev librosbag-dev libpcl-ros-dev
@@ -13,6 +13,8 @@ packages=(
   ros-std-srvs ros-shape-msgs ros-visualization-msgs ros-diagnostic-msgs ros-message-runtime
   python3-roslaunch python3-rosmaster python3-rospy rosout tf2-tools rosbash
 )
+# Extra packages a target needs beyond these (make evaluate: gnuplot-nox).
+packages+=("$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

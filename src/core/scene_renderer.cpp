@@ -243,6 +243,30 @@ Scene makeRampStairsHall()
   return s;
 }
 
+Scene makeClutteredLab()
+{
+  Scene s;
+  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
+  s.addRectangle({0, 0, 0}, ex, ey, 2.5, 2.0, "floor");
+  s.addRectangle({0, 0, 2.6}, ex, ey, 2.5, 2.0, "ceiling");
+  s.addRectangle({2.5, 0, 1.3}, ey, ez, 2.0, 1.3, "wall_east");
+  s.addRectangle({-2.5, 0, 1.3}, ey, ez, 2.0, 1.3, "wall_west");
+  s.addRectangle({0, 2.0, 1.3}, ex, ez, 2.5, 1.3, "wall_north");
+  s.addRectangle({0, -2.0, 1.3}, ex, ez, 2.5, 1.3, "wall_south");
+  s.addBox({1.5, 1.3, 0.37}, {0.7, 0.35, 0.37}, 0.0, "desk_north");
+  s.addBox({-1.2, -1.4, 0.37}, {0.5, 0.4, 0.37}, 0.5, "desk_south");
+  s.addBox({-2.2, 1.2, 0.9}, {0.25, 0.45, 0.9}, 0.0, "cabinet_tall");
+  s.addBox({2.2, -1.2, 0.45}, {0.25, 0.5, 0.45}, 0.0, "cabinet_low");
+  s.addBox({0.4, 1.6, 0.2}, {0.25, 0.2, 0.2}, 0.2, "crate");
+  // Non-planar clutter: bins, a bin on a desk, balls.
+  s.cylinders.push_back(SceneCylinder{{-0.6, 1.5, 0.0}, 0.2, 0.7});
+  s.cylinders.push_back(SceneCylinder{{1.6, 1.3, 0.74}, 0.1, 0.3});
+  s.cylinders.push_back(SceneCylinder{{1.2, -0.9, 0.0}, 0.35, 1.8});
+  s.spheres.push_back(SceneSphere{{-1.4, 0.3, 0.3}, 0.3});
+  s.spheres.push_back(SceneSphere{{0.6, -1.6, 0.25}, 0.25});
+  return s;
+}
+
 std::vector<Eigen::Isometry3d> roomTour(int frames, const Eigen::Vector3d& centre, double radius)
 {
   std::vector<Eigen::Isometry3d> poses;

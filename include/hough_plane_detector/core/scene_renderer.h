@@ -119,6 +119,9 @@ Scene makeOfficeRoom();
 // A 8 x 6 x 3 m hall with a ramp 10 deg off the floor, stairs of 15 cm treads, a door
 // recessed 10 cm into its wall and curved clutter.
 Scene makeRampStairsHall();
+// A 5 x 4 x 2.6 m lab: floor, ceiling, four walls, two desks, two cabinets, a crate, and bins,
+// a pillar and balls that are not planar.
+Scene makeClutteredLab();
 // A still camera turning around the room centre: `frames` poses at 1.0 m height.
 std::vector<Eigen::Isometry3d> roomTour(int frames, const Eigen::Vector3d& centre = Eigen::Vector3d(0, 0, 1.0),
                                         double radius = 0.5);
