@@ -57,6 +57,8 @@ std::string DetectorParams::validate() const
     err << "min_valid_fraction must be in (0, 1], got " << min_valid_fraction << "; ";
   if (!(max_curvature > 0.0 && max_curvature <= 1.0 / 3.0))
     err << "max_curvature must be in (0, 1/3], got " << max_curvature << "; ";
+  if (max_window_scale != 1 && max_window_scale != 2 && max_window_scale != 4)
+    err << "max_window_scale must be 1, 2 or 4, got " << max_window_scale << "; ";
   if (!(sensor_noise >= 0.0 && sensor_noise <= 10.0)) err << "sensor_noise must be in [0, 10], got " << sensor_noise << "; ";
   if (!(support_distance > 0.0)) err << "support_distance must be > 0, got " << support_distance << "; ";
   if (!(support_angle > 0.0 && support_angle < 1.5)) err << "support_angle must be in (0, 1.5) rad, got " << support_angle << "; ";

@@ -83,6 +83,13 @@ double sensorDepthSigma(double depth, double noise_coefficient)
   return std::sqrt(eq11 * eq11 + quantization_step * quantization_step / 12.0);
 }
 
+namespace
+{
+// Squared thickness over squared width (smallest over middle eigenvalue) above which a window's
+// normal is re-measured over a wider window: thickness more than half the width.
+constexpr double kMaxThicknessRatio = 0.25;
+}  // namespace
+
 void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
                               const NormalEstimatorConfig& config, std::vector<WindowSample>& samples)
 {
@@ -174,8 +181,9 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
   const int k = config.window / s;
   const int step = config.stride / s;
   const int ix = blocks_x_ + 1;
-  if (k > 1) integral_.assign(static_cast<size_t>(ix) * (blocks_y_ + 1), PointMoments());
-  for (int by = 0; by < blocks_y_ && k > 1; ++by)
+  const bool need_table = k > 1 || config.max_window_scale > 1;  // wider windows read it too
+  if (need_table) integral_.assign(static_cast<size_t>(ix) * (blocks_y_ + 1), PointMoments());
+  for (int by = 0; by < blocks_y_ && need_table; ++by)
   {
     PointMoments row_sum;
     for (int bx = 0; bx < blocks_x_; ++bx)
@@ -191,41 +199,69 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
   const Eigen::Matrix3d rotation = camera_to_world.linear();
   const Eigen::Vector3d translation = camera_to_world.translation();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  // Moments of the blocks [x0, x1) x [y0, y1), clipped to the grid.
+  auto windowMoments = [&](int x0, int y0, int x1, int y1) {
+    x0 = std::max(0, x0);
+    y0 = std::max(0, y0);
+    x1 = std::min(blocks_x_, x1);
+    y1 = std::min(blocks_y_, y1);
+    if (!need_table) return blocks_[static_cast<size_t>(y0) * blocks_x_ + x0];
+    PointMoments m = integral_[static_cast<size_t>(y1) * ix + x1];
+    m.subtract(integral_[static_cast<size_t>(y0) * ix + x1]);
+    m.subtract(integral_[static_cast<size_t>(y1) * ix + x0]);
+    m.add(integral_[static_cast<size_t>(y0) * ix + x0]);
+    return m;
+  };
   for (int wy = 0; wy + k <= blocks_y_; wy += step)
   {
     for (int wx = 0; wx + k <= blocks_x_; wx += step)
     {
-      PointMoments m;
-      if (k == 1)
-      {
-        m = blocks_[static_cast<size_t>(wy) * blocks_x_ + wx];
-      }
-      else
-      {
-        m = integral_[static_cast<size_t>(wy + k) * ix + wx + k];
-        m.subtract(integral_[static_cast<size_t>(wy) * ix + wx + k]);
-        m.subtract(integral_[static_cast<size_t>(wy + k) * ix + wx]);
-        m.add(integral_[static_cast<size_t>(wy) * ix + wx]);
-      }
-      if (m.count < min_count) continue;
+      const PointMoments base = windowMoments(wx, wy, wx + k, wy + k);
+      if (base.count < min_count) continue;
       ++valid_windows_;
-      const Eigen::Matrix3d cov = m.covariance();
-      solver.computeDirect(cov);
-      const Eigen::Vector3d eigenvalues = solver.eigenvalues();
-      const double trace = eigenvalues.sum();
-      if (!(trace > 0.0)) continue;
+      // Far from a Kinect a window can be as thick (noise) as it is wide, and its normal is then
+      // mostly noise: measure it again over a window twice, then four times, as wide around it.
+      PointMoments m = base;
+      bool planar = false;
+      Eigen::Vector3d eigenvalues;
+      for (int scale = 1; scale <= config.max_window_scale; scale *= 2)
+      {
+        if (scale > 1)
+        {
+          const int x0 = wx - k * (scale - 1) / 2, y0 = wy - k * (scale - 1) / 2;
+          m = windowMoments(x0, y0, x0 + k * scale, y0 + k * scale);
+        }
+        // Depth noise moves points along their rays, which tilts a plain covariance normal
+        // toward the ray on oblique surfaces (0.1 rad on a wall 2.5 m away seen at 45 deg at
+        // C = 1): the noise covariance along the ray is taken out, no more of it than the
+        // window's own thickness shows (so a window less noisy than the model is not over-corrected).
+        const Eigen::Vector3d centre = m.mean();
+        const double sigma = sensorDepthSigma(centre.z(), config.sensor_noise);
+        const Eigen::Vector3d ray = centre / centre.z();  // a depth error e moves a point by e * ray
+        const Eigen::Matrix3d covariance = m.covariance();
+        solver.computeDirect(covariance);
+        const double ray_along_normal = ray.dot(solver.eigenvectors().col(0));
+        const double noise_variance =
+            std::min(sigma * sigma, std::max(0.0, solver.eigenvalues()(0)) / std::max(1e-9, ray_along_normal * ray_along_normal));
+        if (noise_variance > 0.0) solver.computeDirect(covariance - noise_variance * ray * ray.transpose());
+        eigenvalues = solver.eigenvalues();
+        const double trace = eigenvalues.sum();
+        if (!(trace > 0.0)) break;
+        // Planar when flat relative to its size, or no rougher than the sensor's noise at that
+        // depth (far windows of a Kinect are never flat in the first sense).
+        const double noise = 3.0 * sigma;
+        planar = eigenvalues(0) <= config.max_curvature * trace || eigenvalues(0) <= noise * noise;
+        if (planar && eigenvalues(0) <= kMaxThicknessRatio * eigenvalues(1)) break;
+      }
+      if (!planar) continue;
       const Eigen::Vector3d mean = m.mean();
-      // Planar when flat relative to its size, or no rougher than the sensor's noise at that
-      // depth (far windows of a Kinect are never flat in the first sense).
-      const double noise = 3.0 * sensorDepthSigma(mean.z(), config.sensor_noise);
-      if (eigenvalues(0) > config.max_curvature * trace && eigenvalues(0) > noise * noise) continue;
       Eigen::Vector3d normal = solver.eigenvectors().col(0);
       if (normal.dot(mean) > 0.0) normal = -normal;  // toward the sensor at the origin
       WindowSample sample;
       sample.normal = rotation * normal;
       sample.centroid = rotation * mean + translation;
       sample.d = -sample.normal.dot(sample.centroid);
-      sample.count = static_cast<int>(m.count);
+      sample.count = static_cast<int>(base.count);  // votes count the window's own points
       sample.window_x = wx;
       sample.window_y = wy;
       samples.push_back(sample);

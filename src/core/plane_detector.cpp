@@ -117,6 +117,7 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
   normal_config.min_valid_fraction = params_.min_valid_fraction;
   normal_config.max_curvature = params_.max_curvature;
   normal_config.sensor_noise = params_.sensor_noise;
+  normal_config.max_window_scale = params_.max_window_scale;
   normals_.compute(cloud, camera_to_world, normal_config, samples_);
   stats_.windows_valid = normals_.validWindows();
   stats_.samples = static_cast<int>(samples_.size());
@@ -424,12 +425,29 @@ bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<i
   return true;
 }
 
+namespace
+{
+// A block's points all moved to their centroid: fits over many blocks then see the surface
+// without the depth noise inside blocks, which would tilt their normals toward the rays.
+PointMoments centroidMoments(const PointMoments& block)
+{
+  PointMoments m;
+  if (block.count <= 0.0) return m;
+  const Eigen::Vector3d c = block.mean();
+  m.count = block.count;
+  m.sum = block.sum;
+  m.xx = block.count * c.x() * c.x(); m.xy = block.count * c.x() * c.y(); m.xz = block.count * c.x() * c.z();
+  m.yy = block.count * c.y() * c.y(); m.yz = block.count * c.y() * c.z(); m.zz = block.count * c.z() * c.z();
+  return m;
+}
+}  // namespace
+
 bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end) const
 {
   // A curved strip fits a plane within the noise, but its two halves tilt apart.
   const int bx_count = normals_.blocksX();
   PointMoments all;
-  for (size_t i = begin; i < end; ++i) all.add(normals_.block(blocks[i] % bx_count, blocks[i] / bx_count));
+  for (size_t i = begin; i < end; ++i) all.add(centroidMoments(normals_.block(blocks[i] % bx_count, blocks[i] / bx_count)));
   if (all.count < 3) return true;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(all.covariance());
@@ -440,7 +458,7 @@ bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, si
     PointMoments halves[2];
     for (size_t i = begin; i < end; ++i)
     {
-      const PointMoments& block = normals_.block(blocks[i] % bx_count, blocks[i] / bx_count);
+      const PointMoments block = centroidMoments(normals_.block(blocks[i] % bx_count, blocks[i] / bx_count));
       halves[direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0].add(block);
     }
     if (halves[0].count < 3 || halves[1].count < 3) continue;
@@ -464,7 +482,7 @@ PointMoments PlaneDetector::weightedMoments(const std::vector<int>& blocks) cons
   PointMoments sum;
   for (int b : blocks)
   {
-    PointMoments block = normals_.block(b % bx_count, b / bx_count);
+    PointMoments block = centroidMoments(normals_.block(b % bx_count, b / bx_count));
     block.scale(block_info_[b].fit_weight);
     sum.add(block);
   }

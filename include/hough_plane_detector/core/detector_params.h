@@ -25,6 +25,7 @@
   X(int, normal_stride)                \
   X(double, min_valid_fraction)        \
   X(double, max_curvature)             \
+  X(int, max_window_scale)             \
   X(double, sensor_noise)              \
   X(double, support_distance)          \
   X(double, support_angle)
@@ -74,6 +75,9 @@ struct DetectorParams
   double min_valid_fraction = 0.6;
   // Windows whose curvature (smallest eigenvalue / trace) exceeds this are not planar.
   double max_curvature = 0.02;
+  // A window whose noise is as thick as half its width (far from a Kinect) is measured again
+  // over 2x, then 4x, as wide a window around it, up to this factor: 1 (never), 2 or 4.
+  int max_window_scale = 4;
   // C_noc of eq. 11 assumed for the sensor: windows as rough as its noise still count as planar;
   // 0 leaves only the curvature test.
   double sensor_noise = 1.0;

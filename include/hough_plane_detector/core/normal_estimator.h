@@ -35,7 +35,7 @@ struct WindowSample
   Eigen::Vector3d normal;    // world frame, pointing toward the sensor
   Eigen::Vector3d centroid;  // world frame
   double d;                  // normal.p + d = 0
-  int count;                 // valid points in the window
+  int count;                 // valid points in the window (its own, also when measured wider)
   int window_x, window_y;    // window position: its top-left block
 };
 
@@ -47,6 +47,9 @@ struct NormalEstimatorConfig
   double max_curvature = 0.02;
   // C_noc of the Kinect model (eq. 11) assumed for the sensor; 0 turns the noise-aware test off.
   double sensor_noise = 1.0;
+  // Windows whose noise is as thick as half their width are measured again over 2x, then 4x,
+  // as wide a window around them, up to this factor (1: never).
+  int max_window_scale = 4;
 };
 
 // Edge of the pixel blocks that carry point moments for a window and stride (<= 8 pixels).
