@@ -9,9 +9,11 @@
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_ros/transform_broadcaster.h>
 
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/core/scene_renderer.h"
+#include "reconfigure_request.h"
 
 using namespace hough_plane_detector;
 
@@ -62,6 +64,12 @@ std::string diagnosticValue(const std::string& key)
     for (const auto& kv : status.values)
       if (kv.key == key) return kv.value;
   return "";
+}
+
+int diagnosticInt(const std::string& key)
+{
+  const std::string value = diagnosticValue(key);
+  return value.empty() ? -1 : std::stoi(value);
 }
 
 bool waitFor(double seconds, const std::function<bool()>& done)
@@ -166,6 +174,111 @@ TEST(BadInput, RefusedClouds)
   pub.publish(c);
   EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticValue("frames skipped (no transform)") == "2"; }))
       << "skipped count " << diagnosticValue("frames skipped (no transform)");
+}
+
+// odom -> camera as the static publisher of the launch file gives it, under another child name.
+geometry_msgs::TransformStamped cameraTransform(const std::string& child, const ros::Time& stamp)
+{
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = "odom";
+  t.child_frame_id = child;
+  t.transform.translation.z = 1.0;
+  t.transform.rotation.x = -0.5;
+  t.transform.rotation.y = 0.5;
+  t.transform.rotation.z = -0.5;
+  t.transform.rotation.w = 0.5;
+  return t;
+}
+
+TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
+{
+  const std::string node = "/hough_plane_detector";
+  ros::NodeHandle nh;
+  ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("/bad_input/points", 20);
+  ASSERT_TRUE(waitFor(20.0, [&] { return pub.getNumSubscribers() > 0; }));
+  ros::WallDuration(1.0).sleep();
+  for (int i = 0; i < 2; ++i)
+  {
+    sensor_msgs::PointCloud2 good = goodCloud();
+    good.header.stamp = ros::Time::now();
+    pub.publish(good);
+    ros::WallDuration(0.3).sleep();
+  }
+  ASSERT_TRUE(waitFor(10.0, [&] {
+    if (diagnosticInt("frames processed") < 2) return false;
+    std::lock_guard<std::mutex> lock(mutex);
+    return !arrays.empty() && arrays.back()->planes.size() == 1;
+  }));
+  PlaneArray before;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    before = *arrays.back();
+  }
+  const size_t published_before = arrayCount();
+  const int skipped_before = diagnosticInt("frames skipped (no transform)");
+  tf2_ros::TransformBroadcaster broadcaster;
+
+  // NaN in a transform: tf2 refuses it, so the camera frame stays unknown and its cloud is skipped.
+  geometry_msgs::TransformStamped nan_transform = cameraTransform("camera_nan", ros::Time::now());
+  nan_transform.transform.translation.x = std::numeric_limits<double>::quiet_NaN();
+  broadcaster.sendTransform(nan_transform);
+  ros::WallDuration(0.5).sleep();
+  sensor_msgs::PointCloud2 c = goodCloud();
+  c.header.frame_id = "camera_nan";
+  c.header.stamp = ros::Time::now();
+  pub.publish(c);
+  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames skipped (no transform)") >= skipped_before + 1; }))
+      << "a cloud behind a NaN transform was not skipped";
+
+  // A stale transform: known at t0 only, so clouds stamped later need extrapolation; tf2's
+  // filter holds them until newer ones push them out of its queue (size 2), then they count.
+  const ros::Time t0 = ros::Time::now();
+  broadcaster.sendTransform(cameraTransform("camera_stale", t0));
+  ros::WallDuration(0.5).sleep();
+  const int skipped_after_nan = diagnosticInt("frames skipped (no transform)");
+  c.header.frame_id = "camera_stale";
+  c.header.stamp = t0 + ros::Duration(0.5);
+  for (int i = 0; i < 3; ++i) pub.publish(c);
+  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames skipped (no transform)") >= skipped_after_nan + 1; }))
+      << "no cloud needing extrapolation was counted as skipped";
+  EXPECT_EQ(arrayCount(), published_before) << "a cloud without a usable transform changed the map";
+
+  // Time jumps back 30 s (a looping bag): tf is reset, the map kept, and later clouds work,
+  // so the latched static transform came back.
+  ros::WallDuration(1.0).sleep();
+  c = goodCloud();
+  c.header.stamp = ros::Time::now() - ros::Duration(30.0);
+  pub.publish(c);
+  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("time jumps back (tf reset)") == 1; }))
+      << "jumps " << diagnosticValue("time jumps back (tf reset)");
+  ros::WallDuration(1.0).sleep();
+  const int processed = diagnosticInt("frames processed");
+  c.header.stamp = ros::Time::now() - ros::Duration(29.0);
+  pub.publish(c);
+  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames processed") >= processed + 1; }))
+      << "clouds after the tf reset were not processed";
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    ASSERT_EQ(arrays.back()->planes.size(), 1u);
+    EXPECT_EQ(arrays.back()->planes[0].id, before.planes[0].id) << "the map was not kept over the time jump";
+  }
+
+  // Out-of-range reconfigure values: dynamic_reconfigure clamps to the .cfg range; values the
+  // detector cannot use are refused and the current ones kept.
+  const auto clamped = call(node + "/set_parameters", setDouble("thinning_rate", 5.0));
+  for (const auto& p : clamped.response.config.doubles)
+    if (p.name == "thinning_rate") EXPECT_DOUBLE_EQ(p.value, 0.99);
+  const auto refused = call(node + "/set_parameters", setInt("max_window_scale", 3));
+  for (const auto& p : refused.response.config.ints)
+    if (p.name == "max_window_scale") EXPECT_EQ(p.value, 4);
+  const auto restored = call(node + "/set_parameters", setDouble("thinning_rate", 0.05));
+  for (const auto& p : restored.response.config.doubles)
+    if (p.name == "thinning_rate") EXPECT_DOUBLE_EQ(p.value, 0.05);
+  c.header.stamp = ros::Time::now() - ros::Duration(28.0);
+  const size_t published = arrayCount();
+  pub.publish(c);
+  EXPECT_TRUE(waitFor(15.0, [&] { return arrayCount() > published; })) << "the node stopped after reconfigure";
 }
 
 void onPlanes(const PlaneArray::ConstPtr& m)

@@ -8,7 +8,6 @@
 #include <mutex>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
-#include <dynamic_reconfigure/Reconfigure.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -17,6 +16,7 @@
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/SaveMap.h"
 #include "hough_plane_detector/core/scene_renderer.h"
+#include "reconfigure_request.h"
 
 using namespace hough_plane_detector;
 
@@ -93,24 +93,6 @@ bool hasRoomPlanes(const PlaneArray& array, double angle_tol, double d_tol)
   return true;
 }
 
-// A reconfigure request that sets one integer parameter.
-dynamic_reconfigure::Reconfigure setInt(const std::string& name, int value)
-{
-  dynamic_reconfigure::Reconfigure srv;
-  dynamic_reconfigure::IntParameter parameter;
-  parameter.name = name;
-  parameter.value = value;
-  srv.request.config.ints.push_back(parameter);
-  return srv;
-}
-
-template <class Srv>
-Srv call(const std::string& name, Srv srv)
-{
-  EXPECT_TRUE(ros::service::waitForService(name, ros::Duration(30.0))) << name;
-  EXPECT_TRUE(ros::service::call(name, srv)) << name;
-  return srv;
-}
 }  // namespace
 
 TEST(Pipeline, FindsTheRoomsPlanesWithExtentsAndMarkers)

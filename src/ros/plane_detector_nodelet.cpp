@@ -130,11 +130,38 @@ private:
 
   void checkFrameKnown(const sensor_msgs::PointCloud2ConstPtr& cloud)
   {
-    if (!frameUnknown(cloud->header.frame_id)) return;
+    // Right after a tf reset every frame looks unknown for a moment: no verdict then.
+    if (timeJumpedBack(cloud->header.stamp) || !frameUnknown(cloud->header.frame_id)) return;
     std::lock_guard<std::mutex> lock(map_mutex_);
     ++frames_dropped_;
     NODELET_WARN_THROTTLE(5.0, "Cloud skipped: no transform from '%s' to '%s': tf has never seen frame '%s'.",
                           cloud->header.frame_id.c_str(), world_frame_.c_str(), cloud->header.frame_id.c_str());
+  }
+
+  // A looping bag or a restarted simulator sends stamps back in time; tf's cache then holds
+  // the "future". Start tf afresh (a new listener gets the latched static transforms again)
+  // and keep the map: planes live in the world frame, not in time.
+  bool timeJumpedBack(const ros::Time& stamp)
+  {
+    double jump = 0.0;
+    {
+      std::lock_guard<std::mutex> lock(map_mutex_);
+      if (!last_arrival_stamp_.isZero() && stamp + ros::Duration(kTimeJumpTolerance) < last_arrival_stamp_)
+      {
+        jump = (last_arrival_stamp_ - stamp).toSec();
+        ++time_jumps_back_;
+      }
+      last_arrival_stamp_ = stamp;
+    }
+    if (jump == 0.0) return false;
+    NODELET_WARN_THROTTLE(5.0, "Cloud stamps jumped back by %.3f s (a looping bag?): tf buffer cleared, the plane map kept.",
+                          jump);
+    // Not under map_mutex_: the listener's thread may be inside cloudCallback waiting for it.
+    std::lock_guard<std::mutex> lock(tf_reset_mutex_);
+    tf_listener_.reset();
+    tf_buffer_->clear();
+    tf_listener_.reset(new tf2_ros::TransformListener(*tf_buffer_));
+    return true;
   }
 
   void failureCallback(const sensor_msgs::PointCloud2ConstPtr& cloud,
@@ -323,6 +350,7 @@ private:
     status.add("frames skipped (no transform)", frames_dropped_);
     status.add("frames dropped (queue full, detector behind)", frames_queue_dropped_);
     status.add("frames refused (bad cloud)", frames_rejected_);
+    status.add("time jumps back (tf reset)", time_jumps_back_);
     status.add("planes", detector_->planes().size());
     status.add("Hough space MB", memory.global_bytes / 1e6);
     status.add("Hough space % of dense", 100.0 * memory.global_bytes / std::max<size_t>(1, memory.dense_bytes));
@@ -343,10 +371,14 @@ private:
   int frames_processed_ = 0, frames_dropped_ = 0, frames_rejected_ = 0;
   uint64_t frames_queue_dropped_ = 0;
   uint32_t last_seq_ = 0;
+  static constexpr double kTimeJumpTolerance = 1.0;  // s; clouds a little out of order are no jump
+  ros::Time last_arrival_stamp_;
+  int time_jumps_back_ = 0;
   std::deque<ros::WallTime> arrivals_;
 
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::mutex tf_reset_mutex_;  // one tf reset at a time; never taken with map_mutex_ held
   std::unique_ptr<message_filters::Subscriber<sensor_msgs::PointCloud2>> subscriber_;
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> tf_filter_;
   ros::Publisher planes_pub_, markers_pub_, segmented_pub_;
