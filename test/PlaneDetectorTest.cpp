@@ -155,6 +155,30 @@ TEST(PlaneDetector, AVeryNoisySensorStillGivesFloorAndWalls)
               visible, false_detections);
 }
 
+// A wall filling the view is reported from its first frame (strong_support); counting every
+// per-frame plane once, as the paper does, needs two frames; a small patch needs two either way.
+TEST(PlaneDetector, AStronglySupportedPlaneIsReportedAtFirstSight)
+{
+  Scene scene;
+  scene.addRectangle({3.0, 0, 1.0}, kY, kZ, 5.0, 5.0, "wall");
+  scene.addRectangle({1.5, 0.0, 1.0}, kY, kZ, 0.05, 0.05, "tile");  // about 3000 points from 1 m
+  const SceneRenderer renderer(scene);
+  const RenderedFrame first = renderer.render(lookAt({0.5, 0.0, 1.0}, {3.0, 0.3, 1.0}), kinect(1.0), 1);
+  const RenderedFrame second = renderer.render(lookAt({0.5, 0.1, 1.0}, {3.0, 0.3, 1.0}), kinect(1.0), 2);
+  for (int strong_support : {16000, 0})
+  {
+    DetectorParams params;
+    params.strong_support = strong_support;
+    PlaneDetector detector(params);
+    feed(detector, first, 0.0);
+    EXPECT_EQ(matching(detector.planes(), kX, -3.0, 0.01, 0.02).size(), strong_support > 0 ? 1u : 0u)
+        << "strong_support " << strong_support << describe(detector.planes());
+    EXPECT_TRUE(matching(detector.planes(), kX, -1.5, 0.02, 0.02).empty()) << "the small tile needs a second frame";
+    feed(detector, second, 0.1);
+    EXPECT_EQ(matching(detector.planes(), kX, -3.0, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+  }
+}
+
 TEST(PlaneDetector, RefusesAWindowScaleOtherThanOneTwoOrFour)
 {
   DetectorParams params;

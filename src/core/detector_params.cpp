@@ -46,6 +46,7 @@ std::string DetectorParams::validate() const
     err << "thinning_rate must be in [0, 1), got " << thinning_rate << "; ";
   if (!(permanence_cap > global_threshold))
     err << "permanence_cap (" << permanence_cap << ") must exceed global_threshold (" << global_threshold << "); ";
+  if (strong_support < 0) err << "strong_support must be >= 0, got " << strong_support << "; ";
   if (max_chunks < 16) err << "max_chunks must be >= 16, got " << max_chunks << "; ";
   if (!(merge_angle >= 0.0 && merge_angle < 0.5)) err << "merge_angle must be in [0, 0.5) rad, got " << merge_angle << "; ";
   if (!(merge_distance >= 0.0 && merge_distance < 1.0))

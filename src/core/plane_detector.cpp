@@ -607,6 +607,7 @@ void PlaneDetector::findLocalPeaks()
     refined.normal = normal;
     refined.d = d;
     refined.hough = param_.toHough(normal, d);
+    refined.support = moments.count;
     supported.push_back(refined);
   }
   // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
@@ -637,7 +638,22 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   // Thinning (3.7) first, so a plane seen in this frame ends the frame at least 1 higher.
   global_.thin(static_cast<float>(params_.thinning_rate), cap);
 
-  // Algorithm 2: every local peak adds one Gaussian of maximum 1 to the global space.
+  // Algorithm 2: every local peak adds one Gaussian of maximum 1 to the global space. A plane
+  // not yet in the map adds up to 2 when strongly supported, so that a big plane is reported the
+  // first time it is seen, while known planes gain 1 per frame as in the paper (thinning and
+  // permanence keep their pace). Noisier sensors need more points for the same precision: the
+  // bar rises with sensor_noise^2.
+  const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
+  auto inMap = [this](const Peak& peak) {
+    for (const DetectedPlane& plane : planes_)
+    {
+      const double sign = plane.normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
+      if (unsignedAngle(plane.normal, peak.normal) < params_.merge_angle &&
+          std::abs(plane.d - sign * peak.d) < params_.merge_distance)
+        return true;
+    }
+    return false;
+  };
   std::vector<Eigen::Vector3i> seeds;
   auto cellOf = [this](const Eigen::Vector3d& hough) {
     const Eigen::Vector3d c = param_.toCell(hough);
@@ -646,9 +662,12 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   };
   for (const Peak& peak : local_peaks_)
   {
-    addGaussian(global_, peak.hough, 1.0f, cap);
+    const float weight = params_.strong_support > 0 && !inMap(peak)
+                             ? static_cast<float>(1.0 + std::min(1.0, peak.support / strong_support))
+                             : 1.0f;
+    addGaussian(global_, peak.hough, weight, cap);
     Eigen::Vector3d mirrored;
-    if (param_.mirror(peak.hough, mirrored)) addGaussian(global_, mirrored, 1.0f, cap);
+    if (param_.mirror(peak.hough, mirrored)) addGaussian(global_, mirrored, weight, cap);
     seeds.push_back(cellOf(peak.hough));
   }
   for (const DetectedPlane& plane : planes_) seeds.push_back(cellOf(plane.hough));

@@ -16,6 +16,7 @@
   X(double, local_threshold)           \
   X(int, min_support)                  \
   X(double, global_threshold)          \
+  X(int, strong_support)               \
   X(double, thinning_rate)             \
   X(double, permanence_cap)            \
   X(int, max_chunks)                   \
@@ -57,6 +58,10 @@ struct DetectorParams
   int min_support = 800;
   // Minimum global value (about the number of frames that saw the plane) to report a plane.
   double global_threshold = 1.5;
+  // A per-frame plane not yet in the map adds 1 + min(1, points / (strong_support *
+  // max(1, sensor_noise)^2)) to the global space, so one this well supported is reported at
+  // first sight; planes in the map, and all with 0, add 1 (the paper).
+  int strong_support = 16000;
   // Amount every global cell loses per frame (paper 3.7: 0.01 - 0.1).
   double thinning_rate = 0.05;
   // Global cells reaching this value become permanent and stop thinning.

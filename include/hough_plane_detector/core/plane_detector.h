@@ -119,6 +119,7 @@ private:
     Eigen::Vector3d normal;
     double d;
     double value;
+    double support = 0.0;  // points of the frame on the refined per-frame plane
   };
 
   struct BlockInfo
