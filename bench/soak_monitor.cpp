@@ -53,7 +53,7 @@ int main(int argc, char** argv)
     processed = std::stoi(values["frames processed"]);
     if (processed < next_report) continue;
     const double rss = residentMegabytes(pid);
-    if (processed >= warmup && rss_warm < 0) rss_warm = rss;
+    if (processed >= warmup && rss_warm < 0 && rss > 0) rss_warm = rss;
     if (processed >= warmup) rss_max = std::max(rss_max, rss);
     rss_end = rss;
     std::printf("%6d   %14.1f   %8s   %6s   %6s   %8s   %7s   %11s\n", processed, rss, values["Hough space MB"].c_str(),
