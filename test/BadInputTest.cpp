@@ -50,6 +50,18 @@ sensor_msgs::PointCloud2 goodCloud(int width = 640, int height = 480)
   return msg;
 }
 
+// `count` good clouds stamped now, 0.3 s apart.
+void publishGoodClouds(ros::Publisher& pub, int count)
+{
+  for (int i = 0; i < count; ++i)
+  {
+    sensor_msgs::PointCloud2 good = goodCloud();
+    good.header.stamp = ros::Time::now();
+    pub.publish(good);
+    ros::WallDuration(0.3).sleep();
+  }
+}
+
 size_t arrayCount()
 {
   std::lock_guard<std::mutex> lock(mutex);
@@ -92,13 +104,7 @@ TEST(BadInput, RefusedClouds)
   ros::WallDuration(1.0).sleep();  // the static transform reaches the node's buffer
 
   // Three good frames: the wall is in the map.
-  for (int i = 0; i < 3; ++i)
-  {
-    sensor_msgs::PointCloud2 good = goodCloud();
-    good.header.stamp = ros::Time::now();
-    pub.publish(good);
-    ros::WallDuration(0.3).sleep();
-  }
+  publishGoodClouds(pub, 3);
   ASSERT_TRUE(waitFor(10.0, [&] {
     std::lock_guard<std::mutex> lock(mutex);
     return !arrays.empty() && arrays.back()->planes.size() == 1;
@@ -198,13 +204,7 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("/bad_input/points", 20);
   ASSERT_TRUE(waitFor(20.0, [&] { return pub.getNumSubscribers() > 0; }));
   ros::WallDuration(1.0).sleep();
-  for (int i = 0; i < 2; ++i)
-  {
-    sensor_msgs::PointCloud2 good = goodCloud();
-    good.header.stamp = ros::Time::now();
-    pub.publish(good);
-    ros::WallDuration(0.3).sleep();
-  }
+  publishGoodClouds(pub, 2);
   ASSERT_TRUE(waitFor(10.0, [&] {
     if (diagnosticInt("frames processed") < 2) return false;
     std::lock_guard<std::mutex> lock(mutex);
