@@ -221,9 +221,10 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
       ++valid_windows_;
       // Far from a Kinect a window can be as thick (noise) as it is wide, and its normal is then
       // mostly noise: measure it again over a window twice, then four times, as wide around it.
+      // The widest planar measurement wins; a wider window that crosses an edge keeps the last.
       PointMoments m = base;
       bool planar = false;
-      Eigen::Vector3d eigenvalues;
+      Eigen::Vector3d normal, mean;
       for (int scale = 1; scale <= config.max_window_scale; scale *= 2)
       {
         if (scale > 1)
@@ -241,21 +242,22 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
         const Eigen::Matrix3d covariance = m.covariance();
         solver.computeDirect(covariance);
         const double ray_along_normal = ray.dot(solver.eigenvectors().col(0));
-        const double noise_variance =
-            std::min(sigma * sigma, std::max(0.0, solver.eigenvalues()(0)) / std::max(1e-9, ray_along_normal * ray_along_normal));
+        const double noise_variance = std::min(sigma * sigma, std::max(0.0, solver.eigenvalues()(0)) /
+                                                                   std::max(1e-9, ray_along_normal * ray_along_normal));
         if (noise_variance > 0.0) solver.computeDirect(covariance - noise_variance * ray * ray.transpose());
-        eigenvalues = solver.eigenvalues();
+        const Eigen::Vector3d eigenvalues = solver.eigenvalues();
         const double trace = eigenvalues.sum();
         if (!(trace > 0.0)) break;
         // Planar when flat relative to its size, or no rougher than the sensor's noise at that
         // depth (far windows of a Kinect are never flat in the first sense).
         const double noise = 3.0 * sigma;
-        planar = eigenvalues(0) <= config.max_curvature * trace || eigenvalues(0) <= noise * noise;
-        if (planar && eigenvalues(0) <= kMaxThicknessRatio * eigenvalues(1)) break;
+        if (eigenvalues(0) > config.max_curvature * trace && eigenvalues(0) > noise * noise) continue;
+        planar = true;
+        normal = solver.eigenvectors().col(0);
+        mean = centre;
+        if (eigenvalues(0) <= kMaxThicknessRatio * eigenvalues(1)) break;
       }
       if (!planar) continue;
-      const Eigen::Vector3d mean = m.mean();
-      Eigen::Vector3d normal = solver.eigenvectors().col(0);
       if (normal.dot(mean) > 0.0) normal = -normal;  // toward the sensor at the origin
       WindowSample sample;
       sample.normal = rotation * normal;
