@@ -127,6 +127,7 @@ void MethodStats::add(const FrameMetrics& m)
   false_detections += m.false_detections;
   angle.insert(angle.end(), m.angle_errors.begin(), m.angle_errors.end());
   d.insert(d.end(), m.d_errors.begin(), m.d_errors.end());
+  for (int t : m.missed) ++missed_by_plane[t];
 }
 
 void MethodStats::merge(const MethodStats& other)

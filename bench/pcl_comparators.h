@@ -2,6 +2,7 @@
 // organized multi-plane segmentation) plus the small statistics both benchmarks print.
 #pragma once
 
+#include <map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -38,6 +39,7 @@ struct MethodStats
 {
   std::vector<double> ms, angle, d;
   int visible = 0, detected = 0, false_detections = 0, frames = 0;
+  std::map<int, int> missed_by_plane;  // frames each true plane went unmatched (one scene: merge skips it)
   void add(const FrameMetrics& m);
   double detectionPercent() const { return visible ? 100.0 * detected / visible : 0.0; }
   double falsePerFrame() const { return frames ? static_cast<double>(false_detections) / frames : 0.0; }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 #include <stdexcept>
 
@@ -388,6 +389,7 @@ TEST(PlaneDetector, CurvedClutterYieldsNoPlane)
   scene.spheres.push_back({{3.2, -0.2, 0.5}, 0.5});
   SceneRenderer renderer(scene);
   PlaneDetector detector{DetectorParams()};
+  std::map<CandidateVerdict, int> refused;  // the curved surfaces' peaks, by the test that refused them
   for (int f = 0; f < 20; ++f)
   {
     const Eigen::Isometry3d pose = lookAt({0.02 * f, 0.05 * std::sin(0.3 * f), 1.2}, {2.5, 0.0, 0.6});
@@ -395,8 +397,23 @@ TEST(PlaneDetector, CurvedClutterYieldsNoPlane)
     for (const auto& p : detector.planes())
       EXPECT_FALSE(matching({p}, kZ, 0.0, 0.02, 0.03).empty()) << "frame " << f << ": plane that is not the floor"
                                                                << describe({p});
+    // lastCandidates() tells why each peak was or was not a plane: only the floor passes.
+    int floors_accepted = 0;
+    for (const PlaneCandidate& c : detector.lastCandidates())
+    {
+      const bool floor = angleError(c.normal, kZ) < 0.02 && std::abs(c.d) < 0.03;
+      if (c.verdict != CandidateVerdict::kAccepted)
+        ++refused[c.verdict];
+      else
+        EXPECT_TRUE(floor) << "frame " << f << ": accepted candidate off the floor, d " << c.d;
+      floors_accepted += floor && c.verdict == CandidateVerdict::kAccepted;
+    }
+    EXPECT_EQ(floors_accepted, 1) << "frame " << f;
   }
   EXPECT_EQ(matching(detector.planes(), kZ, 0.0, 0.01, 0.02).size(), 1u);
+  int refused_total = 0;
+  for (const auto& [verdict, count] : refused) refused_total += count;
+  EXPECT_GT(refused_total, 0) << "the pillars and balls raised no Hough peak that a planarity test refused";
 }
 
 TEST(PlaneDetector, BadInputIsRefusedAndLeavesTheMapUntouched)

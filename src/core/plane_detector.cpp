@@ -48,6 +48,19 @@ bool isFiniteTransform(const Eigen::Isometry3d& t)
 }
 }  // namespace
 
+const char* toString(CandidateVerdict verdict)
+{
+  switch (verdict)
+  {
+    case CandidateVerdict::kAccepted: return "accepted";
+    case CandidateVerdict::kTooFewPoints: return "too few points";
+    case CandidateVerdict::kCurvedPatches: return "curved patches";
+    case CandidateVerdict::kCentroidsOffPlane: return "centroids off the plane";
+    case CandidateVerdict::kHalvesDisagree: return "halves disagree";
+  }
+  return "unknown";
+}
+
 PlaneDetector::PlaneDetector(const DetectorParams& params)
   : params_(validated(params))
   , param_(params.effectiveAngleStep(), params.effectiveDStep(), params.max_distance, marginCells(params))
@@ -71,6 +84,7 @@ void PlaneDetector::reset()
   local_.clear();
   planes_.clear();
   samples_.clear();
+  candidates_.clear();
   sample_labels_.clear();
   next_id_ = 0;
 }
@@ -554,11 +568,13 @@ void PlaneDetector::findLocalPeaks()
   const double cos_limit = std::cos(params_.support_angle);
   std::vector<Peak> supported;
   std::vector<int> windows, blocks;
+  candidates_.clear();
   for (const Peak& peak : peaks)
   {
     Eigen::Vector3d normal = peak.normal;
     double d = peak.d;
     PointMoments moments, weighted;  // weighted: of the final blocks, reused by the planarity test
+    CandidateVerdict verdict = CandidateVerdict::kAccepted;
     for (int pass = 0; pass < 3; ++pass)
     {
       windows.clear();
@@ -576,12 +592,21 @@ void PlaneDetector::findLocalPeaks()
       if (window_points < params_.min_support)
       {
         moments = PointMoments();
+        verdict = CandidateVerdict::kTooFewPoints;
         break;
       }
       moments = collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
-      if (moments.count < std::max(3, params_.min_support)) break;
+      if (moments.count < std::max(3, params_.min_support))
+      {
+        verdict = CandidateVerdict::kTooFewPoints;
+        break;
+      }
       moments = keepFlatComponents(blocks);
-      if (moments.count < std::max(3, params_.min_support)) break;
+      if (moments.count < std::max(3, params_.min_support))
+      {
+        verdict = CandidateVerdict::kCurvedPatches;
+        break;
+      }
       weighted = weightedMoments(blocks);
       const PointMoments world = weighted.transformed(camera_to_world_);
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -595,8 +620,12 @@ void PlaneDetector::findLocalPeaks()
       d = d_new;
       if (converged) break;
     }
-    if (moments.count < std::max(3, params_.min_support)) continue;
-    if (!isPlanarFit(weighted, blocks) || !halvesAgree(blocks, 0, blocks.size())) continue;
+    if (verdict == CandidateVerdict::kAccepted && !isPlanarFit(weighted, blocks))
+      verdict = CandidateVerdict::kCentroidsOffPlane;
+    else if (verdict == CandidateVerdict::kAccepted && !halvesAgree(blocks, 0, blocks.size()))
+      verdict = CandidateVerdict::kHalvesDisagree;
+    candidates_.push_back({normal, d, peak.value, moments.count, verdict});
+    if (verdict != CandidateVerdict::kAccepted) continue;
     // Claim everything within support_distance, not just the tight fit, so that leftovers
     // around an accepted plane cannot pose as a slightly tilted second one.
     for (int s : windows) claimed[s] = 1;

@@ -44,7 +44,11 @@ FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std:
   {
     if (t >= visible_points.size() || visible_points[t] < min_visible_points) continue;
     ++m.visible;
-    if (true_match[t] < 0) continue;
+    if (true_match[t] < 0)
+    {
+      m.missed.push_back(static_cast<int>(t));
+      continue;
+    }
     ++m.detected;
     const EvaluatedPlane& det = detections[true_match[t]];
     m.angle_errors.push_back(angleError(det.normal, true_planes[t].normal));

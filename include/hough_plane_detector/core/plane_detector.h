@@ -33,6 +33,26 @@ struct DetectedPlane
   Eigen::Vector3d hough = Eigen::Vector3d::Zero();    // canonical (alpha, beta, d) of its peak
 };
 
+// What became of a local Hough peak of the last frame: why a plane in view was not detected.
+enum class CandidateVerdict
+{
+  kAccepted,           // a per-frame plane, voted into the map
+  kTooFewPoints,       // fewer than min_support points lie on it (windows, then blocks)
+  kCurvedPatches,      // its connected patches are curved (halves tilt apart) or tiny
+  kCentroidsOffPlane,  // block centroids scatter more than the sensor noise allows (chi^2)
+  kHalvesDisagree,     // the fits of its two halves differ by more than merge_angle
+};
+const char* toString(CandidateVerdict verdict);
+
+struct PlaneCandidate
+{
+  Eigen::Vector3d normal;  // world frame, after the last refit
+  double d;
+  double peak_value;       // blurred local Hough value of its peak
+  double points;           // points on it when it was accepted or refused (0: too few windows)
+  CandidateVerdict verdict;
+};
+
 struct StageTimings
 {
   double normals_ms = 0, voting_ms = 0, blur_ms = 0, peaks_ms = 0, global_ms = 0, total_ms = 0;
@@ -71,6 +91,8 @@ public:
   const std::vector<DetectedPlane>& planes() const { return planes_; }
   const StageTimings& lastTimings() const { return timings_; }
   const FrameStats& lastStats() const { return stats_; }
+  // Every local peak of the last frame that was tested as a plane, strongest first.
+  const std::vector<PlaneCandidate>& lastCandidates() const { return candidates_; }
   MemoryReport memory() const;
   const DetectorParams& params() const { return params_; }
   const HoughParameterization& parameterization() const { return param_; }
@@ -185,10 +207,11 @@ private:
   std::vector<std::pair<uint64_t, float>> votes_;
   std::vector<std::pair<Eigen::Vector3i, float>> cache_;
   std::vector<Peak> local_peaks_;
+  std::vector<PlaneCandidate> candidates_;
   std::vector<DetectedPlane> planes_;
   std::unordered_map<int, PlaneExtent> extents_;
-  int64_t frame_count_ = 0;
-  size_t chunks_evicted_total_ = 0;  // frames processed since the map began (extents fade by it)
+  int64_t frame_count_ = 0;           // frames processed since the map began (extents fade by it)
+  size_t chunks_evicted_total_ = 0;  // chunks freed by the max_chunks cap since the map began
   int next_id_ = 0;
   StageTimings timings_;
   FrameStats stats_;

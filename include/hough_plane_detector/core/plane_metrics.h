@@ -29,6 +29,7 @@ struct FrameMetrics
   int false_detections = 0;      // detections that match no true plane of the scene
   std::vector<double> angle_errors;  // E_angle per matched visible plane (eq. 12)
   std::vector<double> d_errors;      // E_d per matched visible plane (eq. 13)
+  std::vector<int> missed;           // indices of the visible true planes no detection matched
   double missRate() const { return visible > 0 ? 1.0 - static_cast<double>(detected) / visible : 0.0; }  // eq. 14
 };
 
