@@ -10,9 +10,11 @@ WS := build/ws
 CMAKE_ARGS := -DCMAKE_BUILD_TYPE=Release
 TEST_ENV :=
 else ifeq ($(SANITIZE),thread)
-# make tsan builds this workspace; see the tsan target.
-WS := build/ws-tsan
-CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=-fsanitize=thread -fno-omit-frame-pointer" \
+# make tsan builds this workspace; see the tsan target. TSAN_CONTROL=1 builds the negative
+# control (save_map without the map lock) in its own workspace.
+WS := build/ws-tsan$(if $(TSAN_CONTROL),-control)
+TSAN_DEFINES := $(if $(TSAN_CONTROL),-DHOUGH_PLANE_DETECTOR_TSAN_NEGATIVE_CONTROL)
+CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=-fsanitize=thread -fno-omit-frame-pointer $(TSAN_DEFINES)" \
   "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread" "-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread"
 TEST_ENV :=
 else
@@ -30,7 +32,7 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all deps build test tsan fuzz soak demo demo-offline bench evaluate clean
+.PHONY: all deps build test tsan tsan-control fuzz soak demo demo-offline bench evaluate clean
 
 all: build
 
@@ -56,20 +58,17 @@ test: build
 
 # ThreadSanitizer over the running nodelet: test/concurrency.test (clouds, reconfigure and
 # service calls at once) with the instrumented nodelets in a manager that preloads the runtime;
-# reports go to build/ws-tsan/tsan.*, and any report fails the target (scripts/tsan.supp lists
-# what is suppressed in ROS's uninstrumented libraries, and why).
+# any report in the manager fails the target (scripts/tsan.supp lists what is suppressed in
+# ROS's uninstrumented libraries, and why). make tsan-control proves the run can fail: the
+# same run on a build whose save_map skips the map lock must be reported.
 TSAN_SECONDS ?= 30
 tsan:
 	@$(MAKE) --no-print-directory build SANITIZE=thread
-	@catkin_make -C build/ws-tsan tests > build/ws-tsan/build_tests.log 2>&1 || { tail -30 build/ws-tsan/build_tests.log; false; }
-	@rm -f build/ws-tsan/tsan.*
-	@source build/ws-tsan/devel/setup.bash && HOUGH_PLANE_DETECTOR_STRESS_SECONDS=$(TSAN_SECONDS) \
-	  HOUGH_PLANE_DETECTOR_MANAGER_PREFIX="env LD_PRELOAD=$$(gcc -print-file-name=libtsan.so) TSAN_OPTIONS=log_path=$(CURDIR)/build/ws-tsan/tsan.manager:history_size=4:suppressions=$(CURDIR)/scripts/tsan.supp" \
-	  TSAN_OPTIONS=log_path=$(CURDIR)/build/ws-tsan/tsan.client:suppressions=$(CURDIR)/scripts/tsan.supp rostest --text hough_plane_detector concurrency.test \
-	  2>&1 | grep -E "^\[ *(OK|FAILED) *\]|rounds|Failure" ; \
-	reports=$$(cat build/ws-tsan/tsan.manager.* 2>/dev/null | grep -c "WARNING: ThreadSanitizer" || true); \
-	echo "ThreadSanitizer reports in the nodelet manager: $$reports (build/ws-tsan/tsan.manager.*; the test client's own, in roscpp, are in tsan.client.*)"; \
-	[ "$$reports" = 0 ]
+	@scripts/run_tsan.sh $(CURDIR)/build/ws-tsan $(TSAN_SECONDS) clean
+
+tsan-control:
+	@$(MAKE) --no-print-directory build SANITIZE=thread TSAN_CONTROL=1
+	@scripts/run_tsan.sh $(CURDIR)/build/ws-tsan-control $(TSAN_SECONDS) reported
 
 # libFuzzer on the cloud conversion and the map loader, FUZZ_SECONDS per target.
 FUZZ_SECONDS ?= 300
@@ -98,11 +97,14 @@ evaluate: build
 
 # 10,000 simulated frames through one detector (the core) and then through the nodelet in a
 # manager: resident memory, chunks, planes, ms; valgrind's leak check over short runs of both.
+# make soak SANITIZE=address: the core soak under AddressSanitizer (LeakSanitizer at its exit)
+# and the nodelet's short run under LeakSanitizer instead of valgrind.
 SOAK_FRAMES ?= 10000
 SOAK_VALGRIND_FRAMES ?= 150
 soak: build
-	$(BIN)/soak_detector $(SOAK_FRAMES)
-	@command -v valgrind > /dev/null && valgrind --leak-check=full --errors-for-leak-kinds=definite \
+	@scripts/install_deps.sh valgrind
+	$(BIN)/soak_detector $(if $(SANITIZE),$(SOAK_VALGRIND_FRAMES),$(SOAK_FRAMES))
+	@[ -z "$(SANITIZE)" ] && command -v valgrind > /dev/null && valgrind --leak-check=full --errors-for-leak-kinds=definite \
 	  --error-exitcode=3 $(BIN)/soak_detector 60 2>&1 | grep -E "definitely lost|no leaks are possible|ERROR SUMMARY" || true
 	@scripts/soak_nodelet.sh $(CURDIR)/$(WS) $(SOAK_FRAMES) $(SOAK_VALGRIND_FRAMES)
 
