@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The nodelet soak of make soak: FRAMES clouds through the detector nodelet while soak_monitor
 # prints the manager's resident memory; then a short run of the manager under valgrind, whose
-# definitely-lost blocks that pass through this package's code are counted.
-# Usage: scripts/soak_nodelet.sh WORKSPACE FRAMES VALGRIND_FRAMES
+# definitely-lost blocks that pass through this package's code are counted. In a workspace
+# built with AddressSanitizer (make soak SANITIZE=address) the short run is under LeakSanitizer
+# instead (valgrind cannot run ASan code), and the memory run is left to the plain build.
+# Usage: scripts/soak_nodelet.sh WORKSPACE FRAMES LEAK_CHECK_FRAMES
 set -uo pipefail
 ws=$1
 frames=$2
@@ -32,6 +34,34 @@ run() {  # run LOG FRAMES RATE PREFIX BOND
   return $status
 }
 
+# Leak records (blank-line separated) whose allocation stack passes through this package.
+count_ours() {
+  awk -v start="$2" '$0 ~ start {block=1; text=""} block {text=text $0 "\n"} /^(==[0-9]+== )?$/ {if (block && text ~ /hough_plane_detector/) n++; block=0} END {print n+0}' "$1"
+}
+
+nodelets=$ws/devel/lib/libhough_plane_detector_nodelets.so
+if ldd "$nodelets" | grep -q libasan; then
+  echo "== $valgrind_frames frames at 20 Hz with the manager under LeakSanitizer (the memory run is for the plain build)"
+  preload=$(gcc -print-file-name=libasan.so)
+  if ldd "$nodelets" | grep -q libubsan; then preload="$preload $(gcc -print-file-name=libubsan.so)"; fi
+  rm -f "$ws"/soak_lsan.*
+  run "$ws/soak_nodelet_lsan.log" "$valgrind_frames" 20 \
+    "env LD_PRELOAD='$preload' ASAN_OPTIONS=detect_leaks=1:atexit=1:verify_asan_link_order=0:log_path=$ws/soak_lsan" \
+    --no-bond > /dev/null || { echo "LeakSanitizer run failed: see $ws/soak_nodelet_lsan.log"; exit 1; }
+  # atexit=1 writes ASan's exit statistics: without them the manager never reached its exit
+  # (killed), and LeakSanitizer, which runs there too, did not check anything.
+  log=$(ls "$ws"/soak_lsan.* 2>/dev/null | head -1)
+  if [ -z "$log" ] || ! grep -q "Stats:" "$log"; then
+    echo "the manager did not exit normally, so LeakSanitizer did not run: see $ws/soak_nodelet_lsan.log"
+    exit 1
+  fi
+  grep -E "^SUMMARY" "$log" || echo "LeakSanitizer: no leak in the manager ($log)"
+  ours=$(count_ours "$log" "(Direct|Indirect) leak of")
+  echo "leak records through hough_plane_detector code: $ours (full log: $log)"
+  [ "$ours" = 0 ]
+  exit
+fi
+
 echo "== $frames frames through the nodelet (simulated Kinect replaying a lap at 50 Hz)"
 run "$ws/soak_nodelet.log" "$frames" 50 "" "" || { echo "soak run failed: see $ws/soak_nodelet.log"; exit 1; }
 
@@ -42,6 +72,6 @@ run "$ws/soak_nodelet_valgrind.log" "$valgrind_frames" 5 "valgrind --leak-check=
   --no-bond > /dev/null || { echo "valgrind run failed: see $ws/soak_nodelet_valgrind.log"; exit 1; }
 log=$(ls "$ws"/soak_valgrind.*.log | head -1)
 grep -E "definitely lost:|ERROR SUMMARY" "$log"
-ours=$(awk '/definitely lost in loss record/{block=1; text=""} block{text=text $0 "\n"} /^==[0-9]+== $/{if(block && text ~ /hough_plane_detector/) n++; block=0} END{print n+0}' "$log")
+ours=$(count_ours "$log" "definitely lost in loss record")
 echo "definitely-lost records through hough_plane_detector code: $ours (full log: $log)"
 [ "$ours" = 0 ]
