@@ -18,10 +18,13 @@ supp=$here/scripts/tsan.supp
 HOUGH_PLANE_DETECTOR_STRESS_SECONDS=$seconds \
   HOUGH_PLANE_DETECTOR_MANAGER_PREFIX="env LD_PRELOAD=$(gcc -print-file-name=libtsan.so) TSAN_OPTIONS=log_path=$ws/tsan.manager:history_size=4:suppressions=$supp" \
   TSAN_OPTIONS=log_path=$ws/tsan.client:suppressions=$supp \
-  rostest --text hough_plane_detector concurrency.test 2>&1 | grep -E "^\[ *(OK|FAILED) *\]|rounds|Failure"
+  rostest --text hough_plane_detector concurrency.test > "$ws/tsan_rostest.log" 2>&1
+grep -E "^\[ *(OK|FAILED) *\]|rounds|Failure" "$ws/tsan_rostest.log"
 reports=$(cat "$ws"/tsan.manager.* 2>/dev/null | grep -c "WARNING: ThreadSanitizer")
 echo "ThreadSanitizer reports in the nodelet manager: $reports ($ws/tsan.manager.*; the test client's own, in roscpp, are in tsan.client.*)"
 if [ "$expect" = clean ]; then
+  # A run whose test did not pass proves nothing, reports or not.
+  grep -qE "^\[ *OK *\] Concurrency" "$ws/tsan_rostest.log" || { echo "concurrency.test did not pass: $ws/tsan_rostest.log"; exit 1; }
   [ "$reports" = 0 ]
   exit
 fi

@@ -8,7 +8,7 @@
 set -uo pipefail
 ws=$1
 frames=$2
-valgrind_frames=$3
+leak_check_frames=$3
 here=$(cd "$(dirname "$0")/.." && pwd)
 set +u
 source "$ws/devel/setup.bash"
@@ -41,11 +41,11 @@ count_ours() {
 
 nodelets=$ws/devel/lib/libhough_plane_detector_nodelets.so
 if ldd "$nodelets" | grep -q libasan; then
-  echo "== $valgrind_frames frames at 20 Hz with the manager under LeakSanitizer (the memory run is for the plain build)"
+  echo "== $leak_check_frames frames at 20 Hz with the manager under LeakSanitizer (the memory run is for the plain build)"
   preload=$(gcc -print-file-name=libasan.so)
   if ldd "$nodelets" | grep -q libubsan; then preload="$preload $(gcc -print-file-name=libubsan.so)"; fi
   rm -f "$ws"/soak_lsan.*
-  run "$ws/soak_nodelet_lsan.log" "$valgrind_frames" 20 \
+  run "$ws/soak_nodelet_lsan.log" "$leak_check_frames" 20 \
     "env LD_PRELOAD='$preload' ASAN_OPTIONS=detect_leaks=1:atexit=1:verify_asan_link_order=0:log_path=$ws/soak_lsan" \
     --no-bond > /dev/null || { echo "LeakSanitizer run failed: see $ws/soak_nodelet_lsan.log"; exit 1; }
   # atexit=1 writes ASan's exit statistics: without them the manager never reached its exit
@@ -65,10 +65,10 @@ fi
 echo "== $frames frames through the nodelet (simulated Kinect replaying a lap at 50 Hz)"
 run "$ws/soak_nodelet.log" "$frames" 50 "" "" || { echo "soak run failed: see $ws/soak_nodelet.log"; exit 1; }
 
-echo "== $valgrind_frames frames with the manager under valgrind --leak-check=full"
+echo "== $leak_check_frames frames with the manager under valgrind --leak-check=full"
 vlog=$ws/soak_valgrind.%p.log
 rm -f "$ws"/soak_valgrind.*.log
-run "$ws/soak_nodelet_valgrind.log" "$valgrind_frames" 5 "valgrind --leak-check=full --num-callers=30 --log-file=$vlog" \
+run "$ws/soak_nodelet_valgrind.log" "$leak_check_frames" 5 "valgrind --leak-check=full --num-callers=30 --log-file=$vlog" \
   --no-bond > /dev/null || { echo "valgrind run failed: see $ws/soak_nodelet_valgrind.log"; exit 1; }
 log=$(ls "$ws"/soak_valgrind.*.log | head -1)
 grep -E "definitely lost:|ERROR SUMMARY" "$log"
