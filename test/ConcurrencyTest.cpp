@@ -44,10 +44,10 @@ TEST(Concurrency, CloudsReconfigureAndServicesTogether)
 {
   ros::NodeHandle private_nh("~");
   const double stress_seconds = private_nh.param("stress_seconds", 15.0);
-  // With one callback thread the clouds and the services take turns and nothing here is concurrent.
+  // With one cloud thread no two frames meet in the map: half of what this test is for.
   int concurrency_level = 0;
   ASSERT_TRUE(ros::param::get(kNode + "/concurrency_level", concurrency_level));
-  ASSERT_GT(concurrency_level, 1) << "the detector would take clouds on its single-threaded queue";
+  ASSERT_GT(concurrency_level, 1) << "the detector would process one cloud at a time";
   ASSERT_TRUE(ros::service::waitForService(kNode + "/reset", ros::Duration(60.0)));
   ASSERT_TRUE(ros::service::waitForService(kNode + "/set_parameters", ros::Duration(60.0)));
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(stress_seconds);

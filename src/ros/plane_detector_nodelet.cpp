@@ -9,6 +9,7 @@
 #include <message_filters/subscriber.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
@@ -54,8 +55,10 @@ class PlaneDetectorNodelet : public nodelet::Nodelet
 public:
   ~PlaneDetectorNodelet() override
   {
-    // Stop what calls back into this object before its members go (DEBIAN-ROS pitfall 12).
+    // Stop what calls back into this object before its members go (DEBIAN-ROS pitfall 12);
+    // stop() joins the cloud threads, so no frame is being processed past this line.
     diagnostics_timer_.stop();
+    if (cloud_spinner_) cloud_spinner_->stop();
     tf_filter_.reset();
     subscriber_.reset();
   }
@@ -111,8 +114,11 @@ private:
     diagnostics_->add("plane map", this, &PlaneDetectorNodelet::diagnose);
     diagnostics_timer_ = private_nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_->update(); });
 
-    // A multi-threaded handle lets services answer while a frame is being processed.
-    ros::NodeHandle& cloud_nh = concurrency_level > 1 ? getMTNodeHandle() : nh;
+    // Clouds get their own queue and threads: services answer while a frame is processed, and
+    // tf2's filter keeps a raw pointer to its queue, which must outlive the filter. The manager's
+    // queues do not (at unload the filter's destructor raced the queue's, seen by ThreadSanitizer).
+    ros::NodeHandle cloud_nh(nh);
+    cloud_nh.setCallbackQueue(&cloud_queue_);
     subscriber_.reset(new message_filters::Subscriber<sensor_msgs::PointCloud2>(cloud_nh, "cloud_in", queue_size));
     tf_filter_.reset(new tf2_ros::MessageFilter<sensor_msgs::PointCloud2>(*subscriber_, *tf_buffer_, world_frame_,
                                                                           queue_size, cloud_nh));
@@ -122,6 +128,8 @@ private:
     // tf2's filter holds a cloud of a frame tf has never heard of until newer such clouds push it
     // out of the queue; say so at arrival instead.
     subscriber_->registerCallback(boost::bind(&PlaneDetectorNodelet::checkFrameKnown, this, boost::placeholders::_1));
+    cloud_spinner_.reset(new ros::AsyncSpinner(std::max(1, concurrency_level), &cloud_queue_));
+    cloud_spinner_->start();
     NODELET_INFO("Detecting planes in %s (world frame %s), resolution %d, %d cloud(s) at once.",
                  subscriber_->getTopic().c_str(), world_frame_.c_str(), params_.resolution, std::max(1, concurrency_level));
   }
@@ -384,6 +392,8 @@ private:
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::mutex tf_reset_mutex_;  // one tf reset at a time; never taken with map_mutex_ held
+  ros::CallbackQueue cloud_queue_;  // declared before the filter and subscriber: outlives them
+  std::unique_ptr<ros::AsyncSpinner> cloud_spinner_;
   std::unique_ptr<message_filters::Subscriber<sensor_msgs::PointCloud2>> subscriber_;
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> tf_filter_;
   ros::Publisher planes_pub_, markers_pub_, segmented_pub_;
