@@ -328,7 +328,7 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
   }
   if (!best) return "no Hough peak";
   if (best->verdict == CandidateVerdict::kAccepted) return "seen, not yet in the map";
-  return toString(best->verdict);
+  return std::string(toString(best->verdict)) + (best->parallel_search ? " (parallel search)" : "");
 }
 
 struct MissTally
@@ -434,9 +434,10 @@ void roomExperiments(Report& report)
   for (const auto& [cause, frames] : causes) cause_list += fmt("%s%s: %d", cause_list.empty() ? "" : "; ", cause.c_str(), frames);
   report.md << "### Where our map misses planes (Table 3 frames)\n\n"
             << "Every plane a scored frame showed with enough points and our map did not match, with the frames "
-               "each method missed it. Why ours did, per frame: the fate of the local Hough peak that matches the "
-               "plane (`PlaneDetector::lastCandidates()`), \"no Hough peak\" when no window vote built one above "
-               "local_threshold, \"seen, not yet in the map\" when the frame accepted it but the global space has "
+               "each method missed it. Why ours did, per frame: the fate of the local Hough peak or the parallel "
+               "search's cluster that matches the plane (`PlaneDetector::lastCandidates()`), \"no Hough peak\" "
+               "when neither a window vote above local_threshold nor a cluster of free blocks along a known normal "
+               "came near it, \"seen, not yet in the map\" when the frame accepted it but the global space has "
                "not reached global_threshold.\n\n"
             << "Misses by cause, all scenes: " << (cause_list.empty() ? "none" : cause_list) << ".\n\n"
             << "| scene | plane | frames visible | ours missed (why) | RANSAC missed | OMPS missed |\n"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -25,6 +26,11 @@ int marginCells(const DetectorParams& p)
   // Enough mirrored cells that blur, peak window and sub-voxel mean never see a cut border.
   return p.blur_kernel_size / 2 + p.peak_window / 2 + 2;
 }
+
+constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
+constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
+constexpr double kMaxParallelCentroidSigma = 0.3;  // parallel search: of support_distance
+constexpr double kMinParallelGrazingSine = 0.1;    // parallel search: rays at least ~6 deg to the plane
 
 // Angle between two planes' normals regardless of their sign.
 double unsignedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
@@ -57,6 +63,7 @@ const char* toString(CandidateVerdict verdict)
     case CandidateVerdict::kCurvedPatches: return "curved patches";
     case CandidateVerdict::kCentroidsOffPlane: return "centroids off the plane";
     case CandidateVerdict::kHalvesDisagree: return "halves disagree";
+    case CandidateVerdict::kNotParallel: return "not parallel to the known plane";
   }
   return "unknown";
 }
@@ -423,7 +430,6 @@ bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<i
   const Eigen::Vector3d normal = solver.eigenvectors().col(0);
   const Eigen::Vector3d mean = moments.mean();
   const int bx_count = normals_.blocksX();
-  constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
   double chi2 = 0.0;
   for (int b : blocks)
   {
@@ -435,7 +441,7 @@ bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<i
     const double distance = normal.dot(info.centroid - mean);
     chi2 += distance * distance / (own_variance / count + step * step / 12.0 + kCentroidFloor);
   }
-  if (!blocks.empty() && chi2 / blocks.size() > 4.0) return false;
+  if (!blocks.empty() && chi2 / blocks.size() > kMaxMeanCentroidChi2) return false;
   return true;
 }
 
@@ -456,7 +462,7 @@ PointMoments centroidMoments(const PointMoments& block)
 }
 }  // namespace
 
-bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end) const
+bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const
 {
   // A curved strip fits a plane within the noise, but its two halves tilt apart.
   const int bx_count = normals_.blocksX();
@@ -483,7 +489,7 @@ bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, si
       half_solver.computeDirect(halves[h].covariance());
       half_normals[h] = half_solver.eigenvectors().col(0);
     }
-    if (unsignedAngle(half_normals[0], half_normals[1]) > params_.merge_angle) return false;
+    if (unsignedAngle(half_normals[0], half_normals[1]) > max_angle) return false;
   }
   return true;
 }
@@ -503,7 +509,8 @@ PointMoments PlaneDetector::weightedMoments(const std::vector<int>& blocks) cons
   return sum;
 }
 
-PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks)
+PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
+                                              const std::function<bool(const std::vector<int>&)>& also)
 {
   // Two pillars can share a tangent plane: each connected patch of the support must be flat
   // on its own; curved patches are dropped, tiny ones too (they cannot be tested).
@@ -532,7 +539,15 @@ PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks)
         component.push_back(nb);
       }
     }
-    if (component.size() >= kMinComponentBlocks && halvesAgree(component, 0, component.size()))
+    int x_min = bx_count, x_max = -1, y_min = by_count, y_max = -1;
+    for (int b : component)
+    {
+      x_min = std::min(x_min, b % bx_count), x_max = std::max(x_max, b % bx_count);
+      y_min = std::min(y_min, b / bx_count), y_max = std::max(y_max, b / bx_count);
+    }
+    const bool wide_enough = x_max - x_min + 1 >= min_span && y_max - y_min + 1 >= min_span;
+    if (component.size() >= kMinComponentBlocks && wide_enough && halvesAgree(component, 0, component.size(), max_angle) &&
+        (!also || also(component)))
       kept.insert(kept.end(), component.begin(), component.end());
   }
   blocks.swap(kept);
@@ -601,7 +616,7 @@ void PlaneDetector::findLocalPeaks()
         verdict = CandidateVerdict::kTooFewPoints;
         break;
       }
-      moments = keepFlatComponents(blocks);
+      moments = keepFlatComponents(blocks, params_.merge_angle, 1);
       if (moments.count < std::max(3, params_.min_support))
       {
         verdict = CandidateVerdict::kCurvedPatches;
@@ -622,7 +637,7 @@ void PlaneDetector::findLocalPeaks()
     }
     if (verdict == CandidateVerdict::kAccepted && !isPlanarFit(weighted, blocks))
       verdict = CandidateVerdict::kCentroidsOffPlane;
-    else if (verdict == CandidateVerdict::kAccepted && !halvesAgree(blocks, 0, blocks.size()))
+    else if (verdict == CandidateVerdict::kAccepted && !halvesAgree(blocks, 0, blocks.size(), params_.merge_angle))
       verdict = CandidateVerdict::kHalvesDisagree;
     candidates_.push_back({normal, d, peak.value, moments.count, verdict});
     if (verdict != CandidateVerdict::kAccepted) continue;
@@ -639,9 +654,169 @@ void PlaneDetector::findLocalPeaks()
     refined.support = moments.count;
     supported.push_back(refined);
   }
+  findParallelPlanes(supported);
   // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
   local_peaks_ = supported;
   stats_.local_peaks = static_cast<int>(local_peaks_.size());
+}
+
+double PlaneDetector::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const
+{
+  double chi2 = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = block_info_[b];
+    const double distance = n_cam.dot(info.centroid) + d_cam;
+    chi2 += distance * distance / (info.centroid_variance + kCentroidFloor);
+  }
+  return blocks.empty() ? 0.0 : chi2 / blocks.size();
+}
+
+bool PlaneDetector::fitIsParallel(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+{
+  // Far from a Kinect an 8 x 8 block is as thick as it is wide, so a band of wall blocks at one
+  // height passes for a floor-parallel patch block by block; their centroids together still
+  // span the wall, not a floor.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(weightedMoments(blocks).covariance());
+  return unsignedAngle(solver.eigenvectors().col(0), n_cam) <= 2.0 * params_.merge_angle;
+}
+
+void PlaneDetector::findParallelPlanes(std::vector<Peak>& supported)
+{
+  // Stair treads and risers, shelves: narrower than a normal window, so no window lies on them
+  // alone and they raise no Hough peak; but they are parallel to a floor or wall already
+  // known. Along a known normal, a block's offset d is precise even where its own normal is
+  // noise, so the free blocks' offsets are searched for clusters (a 1-D Hough transform).
+  if (params_.parallel_support <= 0) return;
+  std::vector<Eigen::Vector3d> directions;
+  struct KnownPlane
+  {
+    Eigen::Vector3d normal, normal_cam;
+    double d, d_cam;
+  };
+  std::vector<KnownPlane> known;  // planes a cluster must not repeat, in both frames
+  auto addKnown = [&](const Eigen::Vector3d& normal, double d) {
+    known.push_back({normal, camera_to_world_.linear().transpose() * normal, d,
+                     d + normal.dot(camera_to_world_.translation())});
+    for (const Eigen::Vector3d& direction : directions)
+      if (unsignedAngle(direction, normal) < params_.merge_angle) return;
+    directions.push_back(normal);
+  };
+  for (const Peak& peak : supported) addKnown(peak.normal, peak.d);
+  for (const DetectedPlane& plane : planes_) addKnown(plane.normal, plane.d);
+
+  const int count = static_cast<int>(block_info_.size());
+  const int bx_count = normals_.blocksX();
+  std::vector<std::pair<double, int>> offsets;  // world d of each flat free block, sorted
+  std::vector<char> used;
+  std::vector<int> blocks;
+  for (const Eigen::Vector3d& normal : directions)
+  {
+    const Eigen::Vector3d n_cam = camera_to_world_.linear().transpose() * normal;
+    const double shift = normal.dot(camera_to_world_.translation());  // d_world = d_cam - shift
+    offsets.clear();
+    for (int b = 0; b < count; ++b)
+    {
+      const BlockInfo& info = block_info_[b];
+      if (!info.valid || block_claim_[b] || n_cam.dot(info.covariance * n_cam) > info.thickness_limit) continue;
+      // A block says which side of its neighbours it lies on only if its centroid is much more
+      // precise than the cluster width; and seen along the plane (grazing rays), a wall's block
+      // is as thin along the normal as a floor's: there the thickness test means nothing.
+      if (info.centroid_variance > kMaxParallelCentroidSigma * kMaxParallelCentroidSigma * params_.support_distance *
+                                       params_.support_distance ||
+          std::abs(n_cam.dot(info.centroid.normalized())) < kMinParallelGrazingSine)
+        continue;
+      offsets.emplace_back(-n_cam.dot(info.centroid) - shift, b);
+    }
+    std::sort(offsets.begin(), offsets.end());
+    used.assign(offsets.size(), 0);
+    auto points = [&](size_t i) { return used[i] ? 0.0 : normals_.block(offsets[i].second % bx_count, offsets[i].second / bx_count).count; };
+    while (true)
+    {
+      // The densest interval of support_distance in d, by points.
+      double best = 0.0, window = 0.0;
+      size_t best_begin = 0, best_end = 0;
+      for (size_t begin = 0, end = 0; begin < offsets.size(); window -= points(begin), ++begin)
+      {
+        for (; end < offsets.size() && offsets[end].first <= offsets[begin].first + params_.support_distance; ++end)
+          window += points(end);
+        if (window > best)
+        {
+          best = window;
+          best_begin = begin;
+          best_end = end;
+        }
+      }
+      if (best < params_.parallel_support) break;
+      double weight_sum = 0.0, weighted_d = 0.0;
+      for (size_t i = best_begin; i < best_end; ++i)
+      {
+        if (used[i]) continue;
+        used[i] = 1;
+        weight_sum += block_info_[offsets[i].second].fit_weight;
+        weighted_d += block_info_[offsets[i].second].fit_weight * offsets[i].first;
+      }
+      double d = weighted_d / weight_sum;
+      bool repeats = false;
+      for (const KnownPlane& plane : known)
+      {
+        const double sign = plane.normal.dot(normal) >= 0.0 ? 1.0 : -1.0;
+        if (unsignedAngle(plane.normal, normal) < params_.merge_angle &&
+            std::abs(d - sign * plane.d) < 2.0 * params_.merge_distance)
+          repeats = true;
+      }
+      // Surfaces cut by a plane through the sensor all project to one image line, whose blocks
+      // form that plane for any surface behind them: no plane can be seen edge-on.
+      if (repeats || std::abs(d + shift) < 2.0 * params_.support_distance) continue;
+      // Its blocks: free ones within their own noise of the cluster's plane, in patches that
+      // are not curved (a pillar's front is flat along a wall's normal for a hand's width).
+      // Blocks that lie on a known plane of another tilt (a floor beside a ramp) stay its own.
+      blocks.clear();
+      const double d_cam = d + shift;
+      for (const auto& offset : offsets)
+      {
+        const BlockInfo& info = block_info_[offset.second];
+        const double reach = std::min(params_.support_distance, info.tight_residual);
+        if (block_claim_[offset.second] || std::abs(offset.first - d) > reach) continue;
+        bool on_known = false;
+        for (const KnownPlane& plane : known)
+          if (std::abs(plane.normal_cam.dot(info.centroid) + plane.d_cam) <= reach) on_known = true;
+        if (!on_known) blocks.push_back(offset.second);
+      }
+      // A strip one block wide (a pillar's tangent line) shows no curvature across it; each
+      // patch must lie on the plane within its noise on its own, as others may be clutter.
+      const PointMoments moments = keepFlatComponents(blocks, params_.support_angle, 2, [&](const std::vector<int>& patch) {
+        return centroidChi2(n_cam, d_cam, patch) <= kMaxMeanCentroidChi2;
+      });
+      PlaneCandidate candidate{normal, d, 0.0, moments.count, CandidateVerdict::kAccepted, true};
+      if (moments.count < params_.parallel_support)
+        candidate.verdict = CandidateVerdict::kCurvedPatches;
+      else if (!fitIsParallel(n_cam, blocks))
+        candidate.verdict = CandidateVerdict::kNotParallel;
+      if (candidate.verdict == CandidateVerdict::kAccepted)
+      {
+        weight_sum = weighted_d = 0.0;
+        for (int b : blocks)
+        {
+          block_claim_[b] = 1;
+          weight_sum += block_info_[b].fit_weight;
+          weighted_d += block_info_[b].fit_weight * (-n_cam.dot(block_info_[b].centroid) - shift);
+        }
+        d = candidate.d = weighted_d / weight_sum;
+        Peak peak;
+        peak.normal = normal;
+        peak.d = d;
+        peak.hough = param_.toHough(normal, d);
+        peak.value = 0.0;
+        peak.support = moments.count;
+        peak.parallel = true;
+        supported.push_back(peak);
+        addKnown(normal, d);
+      }
+      candidates_.push_back(candidate);
+    }
+  }
 }
 
 void PlaneDetector::addGaussian(SparseHoughSpace& space, const Eigen::Vector3d& hough, float weight, float cap)
@@ -671,7 +846,8 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   // not yet in the map adds up to 2 when strongly supported, so that a big plane is reported the
   // first time it is seen, while known planes gain 1 per frame as in the paper (thinning and
   // permanence keep their pace). Noisier sensors need more points for the same precision: the
-  // bar rises with sensor_noise^2.
+  // bar rises with sensor_noise^2. A plane of the parallel search measured only its offset (its
+  // normal is a known plane's), so a quarter of the points is as strong.
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
   auto inMap = [this](const Peak& peak) {
     for (const DetectedPlane& plane : planes_)
@@ -692,7 +868,7 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   for (const Peak& peak : local_peaks_)
   {
     const float weight = params_.strong_support > 0 && !inMap(peak)
-                             ? static_cast<float>(1.0 + std::min(1.0, peak.support / strong_support))
+                             ? static_cast<float>(1.0 + std::min(1.0, peak.support / (peak.parallel ? 0.25 * strong_support : strong_support)))
                              : 1.0f;
     addGaussian(global_, peak.hough, weight, cap);
     Eigen::Vector3d mirrored;

@@ -29,7 +29,8 @@
   X(int, max_window_scale)             \
   X(double, sensor_noise)              \
   X(double, support_distance)          \
-  X(double, support_angle)
+  X(double, support_angle)             \
+  X(int, parallel_support)
 
 namespace hough_plane_detector
 {
@@ -90,6 +91,9 @@ struct DetectorParams
   // A window supports a plane when its centroid is this close (m) and its normal this close (rad).
   double support_distance = 0.05;
   double support_angle = 0.2;
+  // Points a plane parallel to one already found (a stair tread, a shelf) needs to be found
+  // among the blocks no Hough peak took, with the known normal; 0 turns that search off.
+  int parallel_support = 800;
 
   // Returns an empty string when the combination is valid, otherwise what is wrong.
   std::string validate() const;

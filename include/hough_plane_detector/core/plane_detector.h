@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <unordered_map>
 #include <string>
@@ -41,6 +42,7 @@ enum class CandidateVerdict
   kCurvedPatches,      // its connected patches are curved (halves tilt apart) or tiny
   kCentroidsOffPlane,  // block centroids scatter more than the sensor noise allows (chi^2)
   kHalvesDisagree,     // the fits of its two halves differ by more than merge_angle
+  kNotParallel,        // parallel search: its blocks' own fit is not parallel to the known plane
 };
 const char* toString(CandidateVerdict verdict);
 
@@ -48,9 +50,10 @@ struct PlaneCandidate
 {
   Eigen::Vector3d normal;  // world frame, after the last refit
   double d;
-  double peak_value;       // blurred local Hough value of its peak
+  double peak_value;       // blurred local Hough value of its peak; 0 for the parallel search
   double points;           // points on it when it was accepted or refused (0: too few windows)
   CandidateVerdict verdict;
+  bool parallel_search = false;  // a cluster of the parallel search, not a Hough peak
 };
 
 struct StageTimings
@@ -142,6 +145,7 @@ private:
     double d;
     double value;
     double support = 0.0;  // points of the frame on the refined per-frame plane
+    bool parallel = false;  // found by the parallel search, with a known plane's normal
   };
 
   struct BlockInfo
@@ -176,12 +180,21 @@ private:
                                   std::vector<int>& blocks, bool tight = false);
   // True when the block centroids of a fitted plane scatter no more than the sensor's noise.
   bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;
-  // True when the fits of the two halves of blocks[begin, end) agree within merge_angle.
-  bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end) const;
+  // True when the fits of the two halves of blocks[begin, end) agree within max_angle.
+  bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const;
+  // Planes parallel to this frame's or the map's planes, among the blocks no plane took.
+  void findParallelPlanes(std::vector<Peak>& supported);
+  // True when the blocks' own fit is within 2 merge_angle of the camera-frame normal.
+  bool fitIsParallel(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
+  // Mean chi^2 of the block centroids about a camera-frame plane of fixed normal.
+  double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
   // Moments of the blocks, each weighted by the inverse variance of the sensor at its depth.
   PointMoments weightedMoments(const std::vector<int>& blocks) const;
-  // Drops the connected patches of `blocks` that are curved or tiny; moments of the rest.
-  PointMoments keepFlatComponents(std::vector<int>& blocks);
+  // Drops the connected patches of `blocks` that are tiny, narrower than min_span blocks across
+  // the image, whose halves tilt apart by more than max_angle (curved) or that fail `also`;
+  // moments of the rest.
+  PointMoments keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
+                                  const std::function<bool(const std::vector<int>&)>& also = nullptr);
   void addGaussian(SparseHoughSpace& space, const Eigen::Vector3d& hough, float weight, float cap);
 
   DetectorParams params_;
