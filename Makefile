@@ -18,8 +18,10 @@ CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=-fsanitize=th
   "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread" "-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread"
 TEST_ENV :=
 else
-WS := build/ws-sanitize
-SAN := -fsanitize=$(SANITIZE)
+# LEAK_CONTROL=1 (make soak-control) builds the negative control of the leak check in its own
+# workspace: the nodelet loses a buffer per cloud.
+WS := build/ws-sanitize$(if $(LEAK_CONTROL),-leak-control)
+SAN := -fsanitize=$(SANITIZE) $(if $(LEAK_CONTROL),-DHOUGH_PLANE_DETECTOR_LEAK_NEGATIVE_CONTROL)
 CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
   "-DCMAKE_EXE_LINKER_FLAGS=$(SAN)" "-DCMAKE_SHARED_LINKER_FLAGS=$(SAN)"
 SAN_RUNTIMES := $(if $(findstring address,$(SANITIZE)),$(shell gcc -print-file-name=libasan.so)) \
@@ -32,7 +34,7 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all deps build test tsan tsan-control fuzz soak demo demo-offline bench evaluate clean
+.PHONY: all deps build test tsan tsan-control fuzz soak soak-control demo demo-offline bench evaluate clean
 
 all: build
 
@@ -107,6 +109,12 @@ soak: build
 	@[ -z "$(SANITIZE)" ] && command -v valgrind > /dev/null && valgrind --leak-check=full --errors-for-leak-kinds=definite \
 	  --error-exitcode=3 $(BIN)/soak_detector 60 2>&1 | grep -E "definitely lost|no leaks are possible|ERROR SUMMARY" || true
 	@scripts/soak_nodelet.sh $(CURDIR)/$(WS) $(SOAK_FRAMES) $(SOAK_VALGRIND_FRAMES)
+
+# Proves the nodelet's LeakSanitizer run can fail: a build whose nodelet loses a buffer per
+# cloud must have leak records through this package's code.
+soak-control:
+	@$(MAKE) --no-print-directory build SANITIZE=address LEAK_CONTROL=1
+	@LEAK_EXPECTED=1 scripts/soak_nodelet.sh $(CURDIR)/build/ws-sanitize-leak-control 0 $(SOAK_VALGRIND_FRAMES)
 
 clean:
 	rm -rf build

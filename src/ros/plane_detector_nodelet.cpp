@@ -190,6 +190,10 @@ private:
 
   void cloudCallback(const sensor_msgs::PointCloud2ConstPtr& cloud)
   {
+#ifdef HOUGH_PLANE_DETECTOR_LEAK_NEGATIVE_CONTROL  // defined only by make soak-control, which must see a leak
+    leak_control_ = new char[4096];  // the previous buffer is lost
+    leak_control_[0] = 1;
+#endif
     Eigen::Isometry3d camera_to_world;
     try
     {
@@ -402,6 +406,9 @@ private:
   std::unique_ptr<dynamic_reconfigure::Server<HoughPlaneDetectorConfig>> reconfigure_server_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
   ros::Timer diagnostics_timer_;
+#ifdef HOUGH_PLANE_DETECTOR_LEAK_NEGATIVE_CONTROL
+  char* leak_control_ = nullptr;
+#endif
 };
 
 }  // namespace hough_plane_detector
