@@ -654,7 +654,9 @@ void PlaneDetector::findLocalPeaks()
     refined.support = moments.count;
     supported.push_back(refined);
   }
+  const auto parallel_start = Clock::now();
   findParallelPlanes(supported);
+  timings_.parallel_ms = msSince(parallel_start);
   // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
   local_peaks_ = supported;
   stats_.local_peaks = static_cast<int>(local_peaks_.size());
@@ -774,8 +776,11 @@ void PlaneDetector::findParallelPlanes(std::vector<Peak>& supported)
       // Blocks that lie on a known plane of another tilt (a floor beside a ramp) stay its own.
       blocks.clear();
       const double d_cam = d + shift;
-      for (const auto& offset : offsets)
+      // Offsets are sorted: only those within support_distance of d can be within reach.
+      const auto first = std::lower_bound(offsets.begin(), offsets.end(), std::make_pair(d - params_.support_distance, -1));
+      for (auto it = first; it != offsets.end() && it->first <= d + params_.support_distance; ++it)
       {
+        const auto& offset = *it;
         const BlockInfo& info = block_info_[offset.second];
         const double reach = std::min(params_.support_distance, info.tight_residual);
         if (block_claim_[offset.second] || std::abs(offset.first - d) > reach) continue;

@@ -59,6 +59,7 @@ struct PlaneCandidate
 struct StageTimings
 {
   double normals_ms = 0, voting_ms = 0, blur_ms = 0, peaks_ms = 0, global_ms = 0, total_ms = 0;
+  double parallel_ms = 0;  // the parallel search, part of peaks_ms
 };
 
 struct MemoryReport
