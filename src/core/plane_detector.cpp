@@ -701,12 +701,15 @@ void PlaneDetector::findParallelPlanes(std::vector<Peak>& supported)
   auto addKnown = [&](const Eigen::Vector3d& normal, double d) {
     known.push_back({normal, camera_to_world_.linear().transpose() * normal, d,
                      d + normal.dot(camera_to_world_.translation())});
-    for (const Eigen::Vector3d& direction : directions)
-      if (unsignedAngle(direction, normal) < params_.merge_angle) return;
-    directions.push_back(normal);
   };
   for (const Peak& peak : supported) addKnown(peak.normal, peak.d);
   for (const DetectedPlane& plane : planes_) addKnown(plane.normal, plane.d);
+  for (const KnownPlane& plane : known)
+  {
+    bool seen = false;
+    for (const Eigen::Vector3d& direction : directions) seen |= unsignedAngle(direction, plane.normal) < params_.merge_angle;
+    if (!seen) directions.push_back(plane.normal);
+  }
 
   const int count = static_cast<int>(block_info_.size());
   const int bx_count = normals_.blocksX();
@@ -770,12 +773,12 @@ void PlaneDetector::findParallelPlanes(std::vector<Peak>& supported)
       }
       // Surfaces cut by a plane through the sensor all project to one image line, whose blocks
       // form that plane for any surface behind them: no plane can be seen edge-on.
-      if (repeats || std::abs(d + shift) < 2.0 * params_.support_distance) continue;
+      const double d_cam = d + shift;
+      if (repeats || std::abs(d_cam) < 2.0 * params_.support_distance) continue;
       // Its blocks: free ones within their own noise of the cluster's plane, in patches that
       // are not curved (a pillar's front is flat along a wall's normal for a hand's width).
       // Blocks that lie on a known plane of another tilt (a floor beside a ramp) stay its own.
       blocks.clear();
-      const double d_cam = d + shift;
       // Offsets are sorted: only those within support_distance of d can be within reach.
       const auto first = std::lower_bound(offsets.begin(), offsets.end(), std::make_pair(d - params_.support_distance, -1));
       for (auto it = first; it != offsets.end() && it->first <= d + params_.support_distance; ++it)
