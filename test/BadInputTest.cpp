@@ -268,13 +268,13 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   // detector cannot use are refused and the current ones kept.
   const auto clamped = call(node + "/set_parameters", setDouble("thinning_rate", 5.0));
   for (const auto& p : clamped.response.config.doubles)
-    if (p.name == "thinning_rate") EXPECT_DOUBLE_EQ(p.value, 0.99);
+    if (p.name == "thinning_rate") { EXPECT_DOUBLE_EQ(p.value, 0.99); }
   const auto refused = call(node + "/set_parameters", setInt("max_window_scale", 3));
   for (const auto& p : refused.response.config.ints)
-    if (p.name == "max_window_scale") EXPECT_EQ(p.value, 4);
+    if (p.name == "max_window_scale") { EXPECT_EQ(p.value, 4); }
   const auto restored = call(node + "/set_parameters", setDouble("thinning_rate", 0.05));
   for (const auto& p : restored.response.config.doubles)
-    if (p.name == "thinning_rate") EXPECT_DOUBLE_EQ(p.value, 0.05);
+    if (p.name == "thinning_rate") { EXPECT_DOUBLE_EQ(p.value, 0.05); }
   c.header.stamp = ros::Time::now() - ros::Duration(28.0);
   const size_t published = arrayCount();
   pub.publish(c);

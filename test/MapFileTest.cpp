@@ -24,12 +24,6 @@ void warmUp(PlaneDetector& detector, int frames)
   }
 }
 
-std::string readFile(const std::string& path)
-{
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 void writeFile(const std::string& path, const std::string& bytes)
 {
   std::ofstream(path, std::ios::binary) << bytes;

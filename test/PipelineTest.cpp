@@ -218,7 +218,7 @@ TEST(Pipeline, ReconfiguringTheResolutionRebuildsTheSpaceAndBadValuesAreRefused)
   // A window that is not a multiple of the stride is refused: the server answers with the old value.
   const dynamic_reconfigure::Reconfigure bad = call(kNode + "/set_parameters", setInt("normal_window", 12));
   for (const auto& p : bad.response.config.ints)
-    if (p.name == "normal_window") EXPECT_EQ(p.value, 32);
+    if (p.name == "normal_window") { EXPECT_EQ(p.value, 32); }
 }
 
 int main(int argc, char** argv)

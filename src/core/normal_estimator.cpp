@@ -58,7 +58,7 @@ PointMoments PointMoments::transformed(const Eigen::Isometry3d& transform) const
   return m;
 }
 
-int blockSize(int window, int stride)
+int blockSize(int /*window: a multiple of the stride*/, int stride)
 {
   // The largest divisor of the stride (so also of the window) that is at most 8.
   for (int b = std::min(8, stride); b > 1; --b)
