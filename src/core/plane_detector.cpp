@@ -31,6 +31,7 @@ constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter
 constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
 constexpr double kMaxParallelCentroidSigma = 0.3;  // parallel search: of support_distance
 constexpr double kMinParallelGrazingSine = 0.1;    // parallel search: rays at least ~6 deg to the plane
+constexpr double kMinSnapInlierShare = 0.8;        // snapping: points that must lie on the parallel plane
 
 // Angle between two planes' normals regardless of their sign.
 double unsignedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
@@ -639,6 +640,7 @@ void PlaneDetector::findLocalPeaks()
       verdict = CandidateVerdict::kCentroidsOffPlane;
     else if (verdict == CandidateVerdict::kAccepted && !halvesAgree(blocks, 0, blocks.size(), params_.merge_angle))
       verdict = CandidateVerdict::kHalvesDisagree;
+    const bool snapped = verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, blocks, supported);
     candidates_.push_back({normal, d, peak.value, moments.count, verdict});
     if (verdict != CandidateVerdict::kAccepted) continue;
     // Claim everything within support_distance, not just the tight fit, so that leftovers
@@ -652,6 +654,7 @@ void PlaneDetector::findLocalPeaks()
     refined.d = d;
     refined.hough = param_.toHough(normal, d);
     refined.support = moments.count;
+    refined.parallel = snapped;
     supported.push_back(refined);
   }
   const auto parallel_start = Clock::now();
@@ -660,6 +663,67 @@ void PlaneDetector::findLocalPeaks()
   // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
   local_peaks_ = supported;
   stats_.local_peaks = static_cast<int>(local_peaks_.size());
+}
+
+bool PlaneDetector::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
+                                         const std::vector<Peak>& supported) const
+{
+  // A small or far plane nearly parallel to a known one (a stair tread to the floor, a shelf
+  // top) is fitted with a tilt of a few degrees: blocks of the surfaces it meets lean on its
+  // edges. If most of its points lie on a plane of the known normal within their noise, that
+  // plane, with one parameter fewer, is the better model.
+  const Eigen::Vector3d* closest = nullptr;
+  double closest_angle = params_.snap_angle;
+  auto consider = [&](const Eigen::Vector3d& known) {
+    const double angle = unsignedAngle(known, normal);
+    if (angle < closest_angle)
+    {
+      closest_angle = angle;
+      closest = &known;
+    }
+  };
+  for (const DetectedPlane& plane : planes_) consider(plane.normal);
+  for (const Peak& peak : supported) consider(peak.normal);
+  if (!closest || blocks.empty()) return false;
+  const Eigen::Vector3d known = closest->dot(normal) >= 0.0 ? *closest : Eigen::Vector3d(-*closest);
+  const Eigen::Vector3d n_cam = camera_to_world_.linear().transpose() * known;
+  // The offset most points agree on (a median: the leaning blocks are outliers), then the
+  // blocks within three of their sigmas of it.
+  const int bx_count = normals_.blocksX();
+  auto points = [&](int b) { return normals_.block(b % bx_count, b / bx_count).count; };
+  std::vector<std::pair<double, double>> offsets;  // camera-frame d of each block, its points
+  double total = 0.0;
+  for (int b : blocks)
+  {
+    offsets.emplace_back(-n_cam.dot(block_info_[b].centroid), points(b));
+    total += points(b);
+  }
+  std::sort(offsets.begin(), offsets.end());
+  double median = offsets.back().first, below = 0.0;
+  for (const auto& offset : offsets)
+    if ((below += offset.second) >= 0.5 * total)
+    {
+      median = offset.first;
+      break;
+    }
+  std::vector<int> inliers;
+  double inlier_points = 0.0, weight_sum = 0.0, weighted_d = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = block_info_[b];
+    const double offset = -n_cam.dot(info.centroid);
+    if (std::abs(offset - median) > 3.0 * std::sqrt(info.centroid_variance + kCentroidFloor)) continue;
+    inliers.push_back(b);
+    inlier_points += points(b);
+    weight_sum += info.fit_weight;
+    weighted_d += info.fit_weight * offset;
+  }
+  if (inlier_points < kMinSnapInlierShare * total) return false;
+  const double d_cam = weighted_d / weight_sum;
+  if (centroidChi2(n_cam, d_cam, inliers) > kMaxMeanCentroidChi2) return false;
+  normal = known;
+  d = d_cam - known.dot(camera_to_world_.translation());
+  return true;
 }
 
 double PlaneDetector::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const
@@ -854,8 +918,8 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   // not yet in the map adds up to 2 when strongly supported, so that a big plane is reported the
   // first time it is seen, while known planes gain 1 per frame as in the paper (thinning and
   // permanence keep their pace). Noisier sensors need more points for the same precision: the
-  // bar rises with sensor_noise^2. A plane of the parallel search measured only its offset (its
-  // normal is a known plane's), so a quarter of the points is as strong.
+  // bar rises with sensor_noise^2. A plane of the parallel search, or one snapped to a known
+  // normal, measured only its offset, so a quarter of the points is as strong.
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
   auto inMap = [this](const Peak& peak) {
     for (const DetectedPlane& plane : planes_)

@@ -30,7 +30,8 @@
   X(double, sensor_noise)              \
   X(double, support_distance)          \
   X(double, support_angle)             \
-  X(int, parallel_support)
+  X(int, parallel_support)             \
+  X(double, snap_angle)
 
 namespace hough_plane_detector
 {
@@ -94,6 +95,10 @@ struct DetectorParams
   // Points a plane parallel to one already found (a stair tread, a shelf) needs to be found
   // among the blocks no Hough peak took, with the known normal; 0 turns that search off.
   int parallel_support = 800;
+  // A per-frame plane within this angle (rad) of a known plane's normal takes that normal when
+  // most of its points lie on the parallel plane within their noise (a far stair tread leaning
+  // on its edges); 0 never.
+  double snap_angle = 0.1;
 
   // Returns an empty string when the combination is valid, otherwise what is wrong.
   std::string validate() const;

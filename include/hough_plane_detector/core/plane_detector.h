@@ -146,7 +146,7 @@ private:
     double d;
     double value;
     double support = 0.0;  // points of the frame on the refined per-frame plane
-    bool parallel = false;  // found by the parallel search, with a known plane's normal
+    bool parallel = false;  // with a known plane's normal: the parallel search's, or snapped to it
   };
 
   struct BlockInfo
@@ -187,6 +187,11 @@ private:
   void findParallelPlanes(std::vector<Peak>& supported);
   // True when the blocks' own fit is within 2 merge_angle of the camera-frame normal.
   bool fitIsParallel(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
+  // Gives an accepted plane within snap_angle of a known plane (the map's or this frame's)
+  // that normal, and the offset its blocks agree on, when most of its points lie on that
+  // parallel plane within their noise. True if it did.
+  bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
+                            const std::vector<Peak>& supported) const;
   // Mean chi^2 of the block centroids about a camera-frame plane of fixed normal.
   double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
   // Moments of the blocks, each weighted by the inverse variance of the sensor at its depth.
