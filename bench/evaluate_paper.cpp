@@ -432,11 +432,15 @@ void otherToursExperiment(Report& report)
     double radius;
     uint32_t seed;
   };
-  const Tour tours[] = {{"Table 3's path, noise seed 5000", 60, {0, 0, 1.0}, 0.5, 5000},
-                        {"Table 3's path, noise seed 77000", 60, {0, 0, 1.0}, 0.5, 77000},
-                        {"45 poses on Table 3's circle", 45, {0, 0, 1.0}, 0.5, 300},
-                        {"circle of 0.7 m about (0.3, -0.2), 50 poses", 50, {0.3, -0.2, 1.0}, 0.7, 900},
-                        {"circle of 0.4 m about (-0.4, 0.3), camera 1.3 m high, 40 poses", 40, {-0.4, 0.3, 1.3}, 0.4, 1700}};
+  // The first five were used while developing the snap to a known normal (to refuse variants
+  // that made false planes there); the last two were first run after the detector was fixed.
+  const Tour tours[] = {{"A: Table 3's path, noise seed 5000", 60, {0, 0, 1.0}, 0.5, 5000},
+                        {"B: Table 3's path, noise seed 77000", 60, {0, 0, 1.0}, 0.5, 77000},
+                        {"C: 45 poses on Table 3's circle", 45, {0, 0, 1.0}, 0.5, 300},
+                        {"D: circle of 0.7 m about (0.3, -0.2), 50 poses", 50, {0.3, -0.2, 1.0}, 0.7, 900},
+                        {"E: circle of 0.4 m about (-0.4, 0.3), camera 1.3 m high, 40 poses", 40, {-0.4, 0.3, 1.3}, 0.4, 1700},
+                        {"F: circle of 0.3 m about (0.5, 0.4), camera 1.1 m high, 55 poses", 55, {0.5, 0.4, 1.1}, 0.3, 2024},
+                        {"G: circle of 0.6 m about (-0.2, -0.5), camera 0.9 m high, 48 poses", 48, {-0.2, -0.5, 0.9}, 0.6, 3131}};
   const size_t tour_count = report.quick ? 1 : sizeof(tours) / sizeof(tours[0]);
   const int stride = 3;
   std::string table = "| tour (all three scenes) | method | E_angle (rad) | E_d (m) | detected | false / frame | frames |\n"
@@ -478,7 +482,9 @@ void otherToursExperiment(Report& report)
             << "The detector's thresholds were chosen while looking at Table 3's tours (and the unit tests' "
                "scenes). These runs render the same three scenes with other noise seeds and along other "
                "camera paths, scored the same way (every 3rd frame from frame 3), so they show how much of "
-               "Table 3 carries over to views the thresholds were not chosen on. Where ours misses: "
+               "Table 3 carries over to views the thresholds were not chosen on. Tours A-E were also looked at "
+               "while the snap to a known normal was developed (variants that made false planes there were "
+               "dropped); F and G were first run after the detector was fixed. Where ours misses: "
             << (cause_list.empty() ? "nothing" : cause_list) << ".\n\n"
             << table << '\n';
   report.verdict(all_ours.detectionPercent() >= 95.0 && all_ours.falsePerFrame() < 0.05,
