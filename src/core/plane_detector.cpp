@@ -674,12 +674,12 @@ bool PlaneDetector::snapToKnownDirection(Eigen::Vector3d& normal, double& d, con
   // plane, with one parameter fewer, is the better model.
   const Eigen::Vector3d* closest = nullptr;
   double closest_angle = params_.snap_angle;
-  auto consider = [&](const Eigen::Vector3d& known) {
-    const double angle = unsignedAngle(known, normal);
+  auto consider = [&](const Eigen::Vector3d& known_normal) {  // an element of planes_ or supported
+    const double angle = unsignedAngle(known_normal, normal);
     if (angle < closest_angle)
     {
       closest_angle = angle;
-      closest = &known;
+      closest = &known_normal;
     }
   };
   for (const DetectedPlane& plane : planes_) consider(plane.normal);
