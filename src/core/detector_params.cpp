@@ -65,6 +65,7 @@ std::string DetectorParams::validate() const
   if (!(support_angle > 0.0 && support_angle < 1.5)) err << "support_angle must be in (0, 1.5) rad, got " << support_angle << "; ";
   if (parallel_support < 0) err << "parallel_support must be >= 0, got " << parallel_support << "; ";
   if (!(snap_angle >= 0.0 && snap_angle < 0.5)) err << "snap_angle must be in [0, 0.5) rad, got " << snap_angle << "; ";
+  if (region_growing != 0 && region_growing != 1) err << "region_growing must be 0 or 1, got " << region_growing << "; ";
   std::string s = err.str();
   if (s.size() >= 2) s.resize(s.size() - 2);
   return s;

@@ -9,6 +9,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "hough_plane_detector/core/block_regions.h"
+
 namespace hough_plane_detector
 {
 
@@ -358,33 +360,6 @@ int PlaneDetector::bestPlaneFor(const WindowSample& sample, const std::vector<Ei
   return best;
 }
 
-void PlaneDetector::describeBlocks()
-{
-  // Per block, once per frame: centroid, covariance and the noise limits the tests use.
-  const int count = normals_.blocksX() * normals_.blocksY();
-  block_info_.resize(count);
-  for (int b = 0; b < count; ++b)
-  {
-    const PointMoments& block = normals_.block(b % normals_.blocksX(), b / normals_.blocksX());
-    BlockInfo& info = block_info_[b];
-    info.valid = block.count >= 3;
-    if (!info.valid) continue;
-    info.centroid = block.mean();
-    info.covariance = block.covariance();
-    const double sigma = sensorDepthSigma(info.centroid.z(), params_.sensor_noise);
-    const double step = params_.sensor_noise > 0.0 ? quantizationStep(info.centroid.z()) : 0.0;
-    // Quantization moves a block as a whole, so it does not average out over the block.
-    info.centroid_variance = sigma * sigma / block.count + step * step / 12.0;
-    // Around a fitted plane a centroid may stray by its noise and 1 cm of sensor warp.
-    info.tight_residual = params_.sensor_noise > 0.0 ? 0.01 + 3.0 * std::sqrt(info.centroid_variance)
-                                                     : params_.support_distance;
-    info.thickness_limit = params_.sensor_noise > 0.0
-                               ? 6.25 * sigma * sigma + 1e-4
-                               : 0.25 * params_.support_distance * params_.support_distance;
-    info.fit_weight = 1.0 / (sigma * sigma + 1e-6);
-  }
-}
-
 PointMoments PlaneDetector::collectPlaneBlocks(const Eigen::Vector3d& normal, double d,
                                               const std::vector<int>& windows, std::vector<int>& blocks,
                                               bool tight)
@@ -446,22 +421,6 @@ bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<i
   return true;
 }
 
-namespace
-{
-// A block's points all moved to their centroid: fits over many blocks then see the surface
-// without the depth noise inside blocks, which would tilt their normals toward the rays.
-PointMoments centroidMoments(const PointMoments& block)
-{
-  PointMoments m;
-  if (block.count <= 0.0) return m;
-  const Eigen::Vector3d c = block.mean();
-  m.count = block.count;
-  m.sum = block.sum;
-  m.xx = block.count * c.x() * c.x(); m.xy = block.count * c.x() * c.y(); m.xz = block.count * c.x() * c.z();
-  m.yy = block.count * c.y() * c.y(); m.yz = block.count * c.y() * c.z(); m.zz = block.count * c.z() * c.z();
-  return m;
-}
-}  // namespace
 
 bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const
 {
@@ -477,20 +436,34 @@ bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, si
   {
     const Eigen::Vector3d direction = solver.eigenvectors().col(axis);
     PointMoments halves[2];
+    double half_variance[2] = {0.0, 0.0};  // mean centroid variance of each half's blocks
+    int half_blocks[2] = {0, 0};
     for (size_t i = begin; i < end; ++i)
     {
       const PointMoments block = centroidMoments(normals_.block(blocks[i] % bx_count, blocks[i] / bx_count));
-      halves[direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0].add(block);
+      const int h = direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0;
+      halves[h].add(block);
+      half_variance[h] += block_info_[blocks[i]].centroid_variance + kCentroidFloor;
+      ++half_blocks[h];
     }
+    for (int h = 0; h < 2; ++h)
+      if (half_blocks[h] > 0) half_variance[h] /= half_blocks[h];
     if (halves[0].count < 3 || halves[1].count < 3) continue;
     Eigen::Vector3d half_normals[2];
+    double tilt_variance = 0.0;  // of the angle between the halves' normals, from their fits
     for (int h = 0; h < 2; ++h)
     {
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> half_solver;
       half_solver.computeDirect(halves[h].covariance());
       half_normals[h] = half_solver.eigenvectors().col(0);
+      // A fit of n centroids of noise v spread s^2 along its narrower side tilts by about
+      // sqrt(v / (n s^2)); two or three blocks in a row fix no normal at all.
+      const double spread = half_solver.eigenvalues()(1);
+      tilt_variance += spread > 0.0 ? half_variance[h] / (half_blocks[h] * spread) : 1e9;
     }
-    if (unsignedAngle(half_normals[0], half_normals[1]) > max_angle) return false;
+    const double tilt = unsignedAngle(half_normals[0], half_normals[1]);
+    // Windows' fit: the paper's fixed tolerance; regions: also beyond what the fits' noise explains.
+    if (tilt > max_angle && (!params_.region_growing || tilt > 3.0 * std::sqrt(tilt_variance))) return false;
   }
   return true;
 }
@@ -559,7 +532,7 @@ PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks, double 
 
 void PlaneDetector::findLocalPeaks()
 {
-  describeBlocks();
+  describeBlocks(normals_, params_, block_info_);
   // A peak above the threshold has voted cells next to it blurred to well over half of it
   // (the kernel falls to 0.6 one cell away); climbing from the rest only finds weak peaks.
   std::vector<Eigen::Vector3i> seeds;
@@ -573,6 +546,22 @@ void PlaneDetector::findLocalPeaks()
   std::sort(peaks.begin(), peaks.end(), [](const Peak& a, const Peak& b) { return a.value > b.value; });
   if (peaks.size() > kMaxLocalPeaks) peaks.resize(kMaxLocalPeaks);
 
+  std::vector<Peak> supported;
+  candidates_.clear();
+  if (params_.region_growing)
+    growRegions(peaks, supported);
+  else
+    fitWindowPlanes(peaks, supported);
+  const auto parallel_start = Clock::now();
+  findParallelPlanes(supported);
+  timings_.parallel_ms = msSince(parallel_start);
+  // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
+  local_peaks_ = supported;
+  stats_.local_peaks = static_cast<int>(local_peaks_.size());
+}
+
+void PlaneDetector::fitWindowPlanes(const std::vector<Peak>& peaks, std::vector<Peak>& supported)
+{
   // Greedy, strongest first: a peak takes the windows that agree with it and no earlier
   // plane took, is refined by a least-squares fit to their points, and keeps them. Weaker
   // echoes of the same plane find nothing left; refined per-frame planes that agree to a
@@ -582,9 +571,7 @@ void PlaneDetector::findLocalPeaks()
                          (params_.normal_window * params_.normal_window);
   block_claim_.assign(static_cast<size_t>(normals_.blocksX()) * normals_.blocksY(), 0);
   const double cos_limit = std::cos(params_.support_angle);
-  std::vector<Peak> supported;
   std::vector<int> windows, blocks;
-  candidates_.clear();
   for (const Peak& peak : peaks)
   {
     Eigen::Vector3d normal = peak.normal;
@@ -657,12 +644,76 @@ void PlaneDetector::findLocalPeaks()
     refined.parallel = snapped;
     supported.push_back(refined);
   }
-  const auto parallel_start = Clock::now();
-  findParallelPlanes(supported);
-  timings_.parallel_ms = msSince(parallel_start);
-  // No merge here: greedy claiming already leaves a peak's mirrored twin or echo no windows.
-  local_peaks_ = supported;
-  stats_.local_peaks = static_cast<int>(local_peaks_.size());
+}
+
+void PlaneDetector::growRegions(const std::vector<Peak>& peaks, std::vector<Peak>& supported)
+{
+  // Strongest first, each peak seeds regions of blocks that agree with it; each region grows
+  // over the neighbouring blocks that lie on its refitted plane within their noise and is
+  // kept when it is a plane by the same statistics. Blocks a kept region took are taken for
+  // the weaker peaks. Then every flat block left seeds a region of its own plane: faces too
+  // small for a window's vote (box sides, far shelves) are still planes of the frame.
+  block_claim_.assign(block_info_.size(), 0);
+  std::vector<char> tried(block_info_.size(), 0);
+  BlockRegionGrower grower(normals_, block_info_, params_);
+  const Eigen::Matrix3d world_to_camera = camera_to_world_.linear().transpose();
+  auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
+    PlaneRegion region = grower.grow(seed, n_cam, d_cam, block_claim_);
+    for (int b : region.blocks) tried[b] = 1;
+    CandidateVerdict verdict = CandidateVerdict::kAccepted;
+    PointMoments moments;
+    if (region.points < std::max(3, params_.min_support))
+      verdict = CandidateVerdict::kTooFewPoints;
+    else if ((moments = keepFlatComponents(region.blocks, params_.merge_angle, 1)).count < std::max(3, params_.min_support))
+      verdict = CandidateVerdict::kCurvedPatches;
+    else if (!grower.fit(region.blocks, region.normal, region.d))
+      verdict = CandidateVerdict::kTooFewPoints;
+    else if (!isPlanarFit(weightedMoments(region.blocks), region.blocks))
+      verdict = CandidateVerdict::kCentroidsOffPlane;
+    else if (!halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
+      verdict = CandidateVerdict::kHalvesDisagree;
+    Eigen::Vector3d normal = camera_to_world_.linear() * region.normal;
+    double d = region.d - normal.dot(camera_to_world_.translation());
+    const bool snapped = verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, supported);
+    candidates_.push_back({normal, d, peak_value, std::max(region.points, moments.count), verdict});
+    if (verdict != CandidateVerdict::kAccepted) return;
+    for (int b : region.blocks) block_claim_[b] = 1;
+    Peak refined;
+    refined.normal = normal;
+    refined.d = d;
+    refined.hough = param_.toHough(normal, d);
+    refined.value = peak_value;
+    refined.support = moments.count;
+    refined.parallel = snapped;
+    supported.push_back(refined);
+  };
+  constexpr size_t kMinSeedBlocks = 2;
+  for (const Peak& peak : peaks)
+  {
+    const Eigen::Vector3d n_cam = world_to_camera * peak.normal;
+    const double d_cam = peak.d + peak.normal.dot(camera_to_world_.translation());
+    for (const std::vector<int>& seed : grower.seedComponents(n_cam, d_cam, block_claim_))
+    {
+      if (seed.size() < kMinSeedBlocks) break;
+      bool fresh = false;
+      for (int b : seed) fresh |= !block_claim_[b] && !tried[b];
+      if (fresh) consider(seed, n_cam, d_cam, peak.value);
+    }
+  }
+  // Leftover flat blocks, most points first, each with its own plane as the first guess.
+  std::vector<int> order;
+  for (size_t b = 0; b < block_info_.size(); ++b)
+    if (block_info_[b].planar && !block_claim_[b] && !tried[b]) order.push_back(static_cast<int>(b));
+  const int bx_count = normals_.blocksX();
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return normals_.block(a % bx_count, a / bx_count).count > normals_.block(b % bx_count, b / bx_count).count;
+  });
+  for (int b : order)
+  {
+    if (block_claim_[b] || tried[b]) continue;
+    const BlockInfo& info = block_info_[b];
+    consider({b}, info.normal, -info.normal.dot(info.centroid), 0.0);
+  }
 }
 
 bool PlaneDetector::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
@@ -939,7 +990,8 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   };
   for (const Peak& peak : local_peaks_)
   {
-    const float weight = params_.strong_support > 0 && !inMap(peak)
+    const float weight = inMap(peak) ? 1.0f
+                         : params_.strong_support > 0
                              ? static_cast<float>(1.0 + std::min(1.0, peak.support / (peak.parallel ? 0.25 * strong_support : strong_support)))
                              : 1.0f;
     addGaussian(global_, peak.hough, weight, cap);

@@ -31,7 +31,8 @@
   X(double, support_distance)          \
   X(double, support_angle)             \
   X(int, parallel_support)             \
-  X(double, snap_angle)
+  X(double, snap_angle)                \
+  X(int, region_growing)
 
 namespace hough_plane_detector
 {
@@ -99,6 +100,12 @@ struct DetectorParams
   // most of its points lie on the parallel plane within their noise (a far stair tread leaning
   // on its edges); 0 never.
   double snap_angle = 0.1;
+  // Per-frame planes: 0 = each Hough peak takes the windows that agree with it (the paper);
+  // 1 = each peak seeds regions of 8 x 8 pixel blocks grown while they lie on the refitted plane
+  // within the sensor's noise, then the flat blocks left seed regions of their own (small faces
+  // that raise no peak); such a plane passed tests against the noise and enters the map at
+  // first sight.
+  int region_growing = 0;
 
   // Returns an empty string when the combination is valid, otherwise what is wrong.
   std::string validate() const;

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "hough_plane_detector/core/block_regions.h"
 #include "hough_plane_detector/core/cloud_view.h"
 #include "hough_plane_detector/core/detector_params.h"
 #include "hough_plane_detector/core/hough_parameterization.h"
@@ -149,21 +150,14 @@ private:
     bool parallel = false;  // with a known plane's normal: the parallel search's, or snapped to it
   };
 
-  struct BlockInfo
-  {
-    bool valid = false;
-    Eigen::Vector3d centroid;
-    Eigen::Matrix3d covariance;
-    double centroid_variance = 0;  // expected scatter of the centroid about its true plane
-    double tight_residual = 0;     // farthest a centroid may lie from a fitted plane
-    double thickness_limit = 0;    // largest spread along the plane normal
-    double fit_weight = 1;         // inverse depth-noise variance
-  };
-
   void vote();
-  void describeBlocks();
   void blurCache();
   void findLocalPeaks();
+  // The paper's per-frame fit: each peak takes the windows that agree with it and their blocks.
+  void fitWindowPlanes(const std::vector<Peak>& peaks, std::vector<Peak>& supported);
+  // region_growing: each peak seeds block regions grown on their refitted planes; then the
+  // flat blocks left seed regions of their own.
+  void growRegions(const std::vector<Peak>& peaks, std::vector<Peak>& supported);
   void updateGlobal(const Eigen::Vector3d& camera_position, double stamp);
   // Climbs from a cell to the local maximum under the (value, -index) total order.
   Eigen::Vector3i climb(const SparseHoughSpace& space, Eigen::Vector3i cell) const;

@@ -1,0 +1,335 @@
+#include "osd_learn.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+
+#include <nlohmann/json.hpp>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/tools/png_image.h"
+#include "pcl_comparators.h"
+
+namespace hough_plane_detector
+{
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+constexpr double kMatchAngle = 0.06;      // rad, the data set's protocol
+constexpr double kMatchDistance = 0.03;   // m
+constexpr int kPclMinInliers = 1500;      // as the data set's README measured PCL
+constexpr int kCopies = 5;                // a still camera: the same frame five times
+constexpr int kFirstCurvedFrame = 33;     // learn33-44 hold cans and mugs
+
+struct Entry
+{
+  std::string name;
+  Eigen::Vector3d normal;
+  double d;
+  int points;
+  int object;  // 0 for the table, else the object's label / 10 (obj20 -> 2)
+};
+
+double msSince(Clock::time_point t)
+{
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+bool matches(const Eigen::Vector3d& n, double d, const Entry& e, double* angle = nullptr, double* distance = nullptr)
+{
+  const double sign = n.dot(e.normal) >= 0.0 ? 1.0 : -1.0;
+  const double a = std::acos(std::min(1.0, std::abs(n.dot(e.normal))));
+  const double dd = std::abs(sign * d - e.d);
+  if (angle) *angle = a;
+  if (distance) *distance = dd;
+  return a <= kMatchAngle && dd <= kMatchDistance;
+}
+
+// Scores one frame's detections: found entries (with their errors), duplicates, unmatched.
+void score(const std::vector<Entry>& entries, const std::vector<Eigen::Vector4d>& detections, OsdMethodResult& result,
+           std::vector<bool>* found_out = nullptr)
+{
+  std::vector<int> matched(entries.size(), 0);
+  std::vector<double> best_angle(entries.size(), 1e9), best_d(entries.size(), 1e9);
+  for (const Eigen::Vector4d& p : detections)
+  {
+    const Eigen::Vector3d n = p.head<3>().normalized();
+    const double d = p(3) / p.head<3>().norm();
+    // A detection counts for the entry it fits best (box faces a few cm apart stay apart).
+    int best = -1;
+    double best_cost = 1e9;
+    for (size_t i = 0; i < entries.size(); ++i)
+    {
+      double a, dd;
+      if (!matches(n, d, entries[i], &a, &dd)) continue;
+      const double cost = a / kMatchAngle + dd / kMatchDistance;
+      if (cost < best_cost)
+      {
+        best_cost = cost;
+        best = static_cast<int>(i);
+      }
+    }
+    ++result.detections;
+    if (best < 0)
+    {
+      ++result.unmatched;
+      continue;
+    }
+    if (matched[best]++ > 0) ++result.duplicates;
+    double a, dd;
+    matches(n, d, entries[best], &a, &dd);
+    if (a + dd < best_angle[best] + best_d[best])
+    {
+      best_angle[best] = a;
+      best_d[best] = dd;
+    }
+  }
+  result.entries += static_cast<int>(entries.size());
+  ++result.frames;
+  for (size_t i = 0; i < entries.size(); ++i)
+    if (matched[i])
+    {
+      ++result.found;
+      result.angle_errors.push_back(best_angle[i]);
+      result.d_errors.push_back(best_d[i]);
+    }
+  if (found_out)
+  {
+    found_out->assign(entries.size(), false);
+    for (size_t i = 0; i < entries.size(); ++i) (*found_out)[i] = matched[i] > 0;
+  }
+}
+
+std::vector<Eigen::Vector4d> mapPlanes(const PlaneDetector& detector)
+{
+  std::vector<Eigen::Vector4d> out;
+  for (const DetectedPlane& p : detector.planes()) out.emplace_back(p.normal.x(), p.normal.y(), p.normal.z(), p.d);
+  return out;
+}
+
+// What became of the candidate nearest to a missed entry in our detector's last frame.
+std::string missReason(const PlaneDetector& detector, const Entry& entry)
+{
+  const PlaneCandidate* nearest = nullptr;
+  double nearest_cost = 1e9;
+  for (const PlaneCandidate& c : detector.lastCandidates())
+  {
+    double a, dd;
+    matches(c.normal, c.d, entry, &a, &dd);
+    const double cost = a / kMatchAngle + dd / kMatchDistance;
+    if (cost < nearest_cost)
+    {
+      nearest_cost = cost;
+      nearest = &c;
+    }
+  }
+  if (!nearest || nearest_cost > 4.0) return "no Hough peak near it";
+  std::string reason = toString(nearest->verdict);
+  if (nearest_cost > 2.0) return "nearest peak far off (" + reason + ")";
+  if (nearest->verdict == CandidateVerdict::kAccepted)
+    return nearest_cost <= 2.0 && nearest_cost > 1.0 ? "accepted, fitted beyond the tolerance" : "accepted, not in the map";
+  return reason;
+}
+
+// Objects of a curved-object frame with no annotated face: cans and mugs.
+std::set<uint32_t> curvedObjects(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<Entry>& entries)
+{
+  std::set<uint32_t> objects;
+  for (const auto& p : cloud.points)
+    if (p.label >= 20) objects.insert(p.label / 10);
+  for (const Entry& e : entries) objects.erase(static_cast<uint32_t>(e.object));
+  return objects;
+}
+
+// Our detections whose labelled pixels lie mostly on one curved object.
+int planesOnCurvedObjects(const PlaneDetector& detector, const CloudView& view,
+                          const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::set<uint32_t>& curved)
+{
+  if (curved.empty()) return 0;
+  std::vector<int> labels;
+  detector.labelPixels(view, labels);
+  int count = 0;
+  for (const DetectedPlane& plane : detector.planes())
+  {
+    std::map<uint32_t, int> by_object;
+    int total = 0;
+    for (size_t i = 0; i < labels.size(); ++i)
+      if (labels[i] == plane.id)
+      {
+        ++total;
+        ++by_object[cloud.points[i].label / 10];
+      }
+    for (uint32_t object : curved)
+      if (total > 0 && by_object[object] * 2 > total) ++count;
+  }
+  return count;
+}
+
+bool writeSegmentedPicture(const std::string& path, const PlaneDetector& detector, const CloudView& view, std::string* error)
+{
+  std::vector<int> labels;
+  detector.labelPixels(view, labels);
+  std::vector<uint8_t> rgb(view.size() * 3, 0);
+  for (int v = 0; v < view.height; ++v)
+    for (int u = 0; u < view.width; ++u)
+    {
+      const size_t i = static_cast<size_t>(v) * view.width + u;
+      float x, y, z;
+      view.point(u, v, x, y, z);
+      if (!std::isfinite(z)) continue;
+      uint8_t c[3] = {90, 90, 90};
+      if (labels[i] >= 0)
+      {
+        const uint32_t h = static_cast<uint32_t>(labels[i]) * 2654435761u;
+        c[0] = 80 + (h >> 8) % 176, c[1] = 80 + (h >> 16) % 176, c[2] = 80 + (h >> 24) % 176;
+      }
+      std::copy(c, c + 3, rgb.begin() + 3 * i);
+    }
+  return writePng(path, view.width, view.height, rgb, error);
+}
+}  // namespace
+
+bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool with_pcl,
+                      const std::string& picture_dir, OsdResults& results, std::string* error)
+{
+  nlohmann::json annotations;
+  try
+  {
+    std::ifstream in(dir + "/annotations.json");
+    if (!in)
+    {
+      if (error) *error = dir + "/annotations.json cannot be read";
+      return false;
+    }
+    in >> annotations;
+  }
+  catch (const std::exception& e)
+  {
+    if (error) *error = dir + "/annotations.json: " + e.what();
+    return false;
+  }
+  results = OsdResults();
+  OsdMethodResult single, copies, ransac, organized;
+  single.method = "Hough 1024, one frame";
+  copies.method = "Hough 1024, five copies";
+  ransac.method = "PCL RANSAC (1 cm)";
+  organized.method = "PCL OMPS";
+  single.curved_planes = 0;
+  const std::set<std::string> picture_frames = {"learn0.pcd", "learn20.pcd", "learn28.pcd", "learn36.pcd"};
+  for (int index = 0;; ++index)
+  {
+    const std::string name = "learn" + std::to_string(index) + ".pcd";
+    if (!annotations.contains(name)) break;
+    std::vector<Entry> entries;
+    for (const auto& e : annotations[name])
+    {
+      Entry entry{e["name"].get<std::string>(),
+                  Eigen::Vector3d(e["normal"][0].get<double>(), e["normal"][1].get<double>(), e["normal"][2].get<double>()),
+                  e["d"].get<double>(), e["points"].get<int>(), 0};
+      if (entry.name.rfind("obj", 0) == 0) entry.object = std::stoi(entry.name.substr(3, 2)) / 10;
+      entries.push_back(entry);
+    }
+    pcl::PointCloud<pcl::PointXYZRGBL> cloud;
+    if (pcl::io::loadPCDFile(dir + "/" + name, cloud) != 0 || cloud.height < 2)
+    {
+      if (error) *error = dir + "/" + name + " cannot be read as an organized cloud";
+      return false;
+    }
+    CloudView view;
+    view.data = reinterpret_cast<const uint8_t*>(cloud.points.data());
+    view.width = static_cast<int>(cloud.width);
+    view.height = static_cast<int>(cloud.height);
+    view.point_step = sizeof(pcl::PointXYZRGBL);
+    view.row_step = view.point_step * cloud.width;
+
+    PlaneDetector detector(params);
+    std::vector<bool> found;
+    for (int copy = 0; copy < kCopies; ++copy)
+    {
+      if (!detector.processFrame(view, Eigen::Isometry3d::Identity(), 0.1 * copy, error)) return false;
+      if (copy > 0) continue;
+      single.ms.push_back(detector.lastTimings().total_ms);
+      score(entries, mapPlanes(detector), single, &found);
+      for (size_t i = 0; i < entries.size(); ++i)
+        if (!found[i])
+        {
+          OsdMiss miss{name, entries[i].name, entries[i].points, missReason(detector, entries[i])};
+          ++results.misses_by_reason[miss.reason];
+          results.misses.push_back(miss);
+        }
+      if (index >= kFirstCurvedFrame)
+        single.curved_planes += planesOnCurvedObjects(detector, view, cloud, curvedObjects(cloud, entries));
+      if (!picture_dir.empty() && picture_frames.count(name))
+      {
+        const std::string path = picture_dir + "/osd_" + name.substr(0, name.size() - 4) + ".png";
+        std::string png_error;
+        if (writeSegmentedPicture(path, detector, view, &png_error))
+          results.pictures.push_back(path);
+        else
+          std::fprintf(stderr, "%s\n", png_error.c_str());
+      }
+    }
+    copies.ms.push_back(detector.lastTimings().total_ms);
+    score(entries, mapPlanes(detector), copies);
+    if (!with_pcl) continue;
+    const auto pcl_cloud = toPclCloud(view);
+    auto t = Clock::now();
+    const auto r = pclRansacPlanes(pcl_cloud, 1000, 0.01, kPclMinInliers);
+    ransac.ms.push_back(msSince(t));
+    score(entries, r, ransac);
+    t = Clock::now();
+    const auto o = pclOrganizedPlanes(pcl_cloud, kPclMinInliers);
+    organized.ms.push_back(msSince(t));
+    score(entries, o, organized);
+  }
+  if (single.frames == 0)
+  {
+    if (error) *error = dir + "/annotations.json names no learnN.pcd frame";
+    return false;
+  }
+  results.methods = {single, copies};
+  if (with_pcl) results.methods.insert(results.methods.end(), {ransac, organized});
+  return true;
+}
+
+std::string osdLearnMarkdown(const OsdResults& results, const std::string& picture_prefix)
+{
+  char line[512];
+  std::string md =
+      "| method | found | duplicates / frame | unmatched / frame | planes on cans and mugs | E_angle (rad) | E_d (m) | "
+      "median ms |\n|---|---|---|---|---|---|---|---|\n";
+  for (const OsdMethodResult& m : results.methods)
+  {
+    std::snprintf(line, sizeof(line), "| %s | %.1f %% (%d/%d) | %.2f | %.2f | %s | %.4f +- %.4f | %.4f +- %.4f | %.1f |\n",
+                  m.method.c_str(), m.foundPercent(), m.found, m.entries, static_cast<double>(m.duplicates) / m.frames,
+                  static_cast<double>(m.unmatched) / m.frames,
+                  m.curved_planes < 0 ? "-" : std::to_string(m.curved_planes).c_str(), mean(m.angle_errors),
+                  standardDeviation(m.angle_errors), mean(m.d_errors), standardDeviation(m.d_errors), median(m.ms));
+    md += line;
+  }
+  md += "\nOur misses (one frame), by what became of the nearest candidate:";
+  for (const auto& [reason, count] : results.misses_by_reason) md += " " + reason + ": " + std::to_string(count) + ";";
+  md += "\n\n| frame | entry | points | why |\n|---|---|---|---|\n";
+  for (const OsdMiss& miss : results.misses)
+  {
+    std::snprintf(line, sizeof(line), "| %s | %s | %d | %s |\n", miss.frame.c_str(), miss.entry.c_str(), miss.points,
+                  miss.reason.c_str());
+    md += line;
+  }
+  md += "\n";
+  for (const std::string& path : results.pictures)
+  {
+    const std::string file = path.substr(path.find_last_of('/') + 1);
+    md += "![" + file + "](" + picture_prefix + file + ") ";
+  }
+  md += "\n\n";
+  return md;
+}
+
+}  // namespace hough_plane_detector

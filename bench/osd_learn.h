@@ -1,0 +1,54 @@
+// Real frames with annotated planes (../shared/data/osd-learn, its README gives the protocol):
+// each frame alone, and five copies of it (a still camera), through our detector, and once
+// through PCL's RANSAC loop and organized multi-plane segmentation; scored against
+// annotations.json (a detection matches an entry within 0.06 rad and 3 cm).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "hough_plane_detector/core/detector_params.h"
+
+namespace hough_plane_detector
+{
+
+struct OsdMethodResult
+{
+  std::string method;
+  int entries = 0;         // annotated planes
+  int found = 0;           // entries some detection matched
+  int duplicates = 0;      // detections beyond the first that matched an already matched entry
+  int detections = 0;
+  int unmatched = 0;       // detections that match no entry (not necessarily false: see the README)
+  int curved_planes = -1;  // learn33-44: detections whose support lies mostly on one curved object (-1: not measured)
+  int frames = 0;
+  std::vector<double> angle_errors, d_errors, ms;
+  double foundPercent() const { return entries ? 100.0 * found / entries : 0.0; }
+};
+
+struct OsdMiss
+{
+  std::string frame, entry;
+  int points = 0;
+  std::string reason;  // what became of its candidate in our detector
+};
+
+struct OsdResults
+{
+  std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
+  std::vector<OsdMiss> misses;           // ours, single frame
+  std::map<std::string, int> misses_by_reason;
+  std::vector<std::string> pictures;     // segmented frames written (PNG paths)
+};
+
+// Runs the data set in `dir` (annotations.json beside learn*.pcd). `with_pcl` adds the two PCL
+// methods; `picture_dir`, when not empty, receives a few segmented frames as PNG. Returns false
+// with `error` set when the data cannot be read.
+bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool with_pcl,
+                      const std::string& picture_dir, OsdResults& results, std::string* error);
+
+// The Markdown section of RESULTS.md for these results.
+std::string osdLearnMarkdown(const OsdResults& results, const std::string& picture_prefix);
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,73 @@
+// Per-frame planes as connected regions of the normal estimator's pixel blocks, grown from
+// seeds (Hough peaks first). A block joins a region when it is flat within the sensor's
+// noise, its own normal agrees within its uncertainty and its centroid lies on the region's
+// plane within its noise: every test is against the noise expected at the block's depth, so
+// small near faces and large far walls are judged alike.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "hough_plane_detector/core/detector_params.h"
+#include "hough_plane_detector/core/normal_estimator.h"
+
+namespace hough_plane_detector
+{
+
+// One block of the last frame, camera frame, with the noise limits the tests use.
+struct BlockInfo
+{
+  bool valid = false;       // at least 3 points
+  bool planar = false;      // its spread along its normal is the sensor's noise, not an edge
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // of its own points, toward the sensor
+  double normal_tolerance = 0;   // largest angle to a region's normal its noise explains (rad)
+  double centroid_variance = 0;  // expected scatter of the centroid about its true plane
+  double tight_residual = 0;     // farthest a centroid may lie from a fitted plane
+  double region_residual = 0;    // farthest it may lie from its region's plane: noise and systematic error
+  double thickness_limit = 0;    // largest spread along the plane normal
+  double fit_weight = 1;         // inverse depth-noise variance
+};
+
+// Fills `info` (row-major over the estimator's block grid) from the estimator's last frame.
+void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, std::vector<BlockInfo>& info);
+
+// A block's points all moved to their centroid: fits over many blocks then see the surface
+// without the depth noise inside blocks, which would tilt their normals toward the rays.
+PointMoments centroidMoments(const PointMoments& block);
+
+struct PlaneRegion
+{
+  std::vector<int> blocks;
+  double points = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // camera frame, weighted fit of the centroids
+  double d = 0;
+};
+
+class BlockRegionGrower
+{
+public:
+  BlockRegionGrower(const NormalEstimator& grid, const std::vector<BlockInfo>& info, const DetectorParams& params);
+
+  // Planar blocks not yet taken that agree with the camera-frame plane (normal, d), as
+  // 4-connected components, largest first.
+  std::vector<std::vector<int>> seedComponents(const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
+  // Grows `seed` (with a first plane guess) over neighbouring blocks not taken, refitting the
+  // plane after each sweep, until nothing more joins.
+  PlaneRegion grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
+  // True when the block may join a region of plane (normal, d).
+  bool accepts(int block, const Eigen::Vector3d& normal, double d) const;
+  // Weighted least-squares plane of the blocks' centroids; false when they fix no plane.
+  bool fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
+
+private:
+  const NormalEstimator& grid_;
+  const std::vector<BlockInfo>& info_;
+  const DetectorParams& params_;
+  std::vector<int> mark_;
+  int generation_ = 0;
+};
+
+}  // namespace hough_plane_detector
