@@ -4,7 +4,7 @@
 // PCL RANSAC and PCL OrganizedMultiPlaneSegmentation measured on the same frames in this process.
 // Writes OUT_DIR/RESULTS.md and the gnuplot data files OUT_DIR/results/*.dat, which
 // scripts/evaluate.sh plots into OUT_DIR/results/*.png.
-// Usage: evaluate_paper OUT_DIR [--quick] [FRAME.pcd ...]
+// Usage: evaluate_paper OUT_DIR [--quick] [--osd OSD_LEARN_DIR] [FRAME.pcd ...]
 #include <chrono>
 #include <cstdarg>
 #include <cmath>
@@ -24,6 +24,7 @@
 #include "hough_plane_detector/core/plane_metrics.h"
 #include "hough_plane_detector/core/scene_renderer.h"
 #include "hough_plane_detector/tools/input_sources.h"
+#include "osd_learn.h"
 #include "pcl_comparators.h"
 
 using namespace hough_plane_detector;
@@ -627,16 +628,58 @@ bool realFrames(Report& report, const std::vector<std::string>& paths)
             << fmt("| PCL OMPS | %.2f | %zu in the last frame |\n\n", median(organized_ms), organized_planes);
   return true;
 }
+
+// ../shared/data/osd-learn: real frames with annotated planes, the defaults and region_growing.
+bool osdLearnFrames(Report& report, const std::string& dir)
+{
+  if (dir.empty()) return true;
+  DetectorParams regions;
+  regions.region_growing = 1;
+  regions.strong_support = 2000;
+  OsdResults defaults, grown;
+  std::string error;
+  if (!evaluateOsdLearn(dir, DetectorParams(), true, "", defaults, &error) ||
+      !evaluateOsdLearn(dir, regions, false, report.out_dir + "/results", grown, &error))
+  {
+    std::fprintf(stderr, "osd-learn: %s\n", error.c_str());
+    return false;
+  }
+  for (OsdMethodResult& m : grown.methods) m.method += ", region_growing 1, strong_support 2000";
+  OsdResults table = defaults;
+  table.methods.insert(table.methods.begin() + 2, grown.methods.begin(), grown.methods.end());
+  table.misses = grown.misses;
+  table.misses_by_reason = grown.misses_by_reason;
+  const OsdMethodResult& best = grown.methods[0];
+  report.md << "## Real frames with annotated planes (osd-learn)\n\n"
+            << fmt("45 real 640 x 480 table-top frames of a structured-light camera with 190 annotated planes "
+                   "(../shared/data/osd-learn: the table and every flat box face of 2,000+ points; learn33-44 hold cans "
+                   "and mugs). Scored as its README says: a detection matches an entry within 0.06 rad and 3 cm; a "
+                   "second detection of one entry is a duplicate; an unmatched detection is not necessarily false "
+                   "(small faces and the background are not annotated). PCL with 1,500 points as minimum. These frames "
+                   "are not held out: region_growing's noise terms were chosen while looking at them. The misses "
+                   "listed and the pictures (plane colours; grey: on no plane) are region_growing's. Pixel labels "
+                   "(pictures, planes on cans) come from the map's support step, which still assigns 32 px windows: "
+                   "small faces are often left grey and the count of planes on cans is a lower bound.\n\n")
+            << osdLearnMarkdown(table, "results/");
+  report.verdict(best.foundPercent() >= 90.0 && best.duplicates == 0 && best.curved_planes == 0,
+                 fmt("osd-learn, one frame (region_growing 1): %.1f %% of the annotated planes >= 90 %%, %d duplicates, "
+                     "%d planes on cans and mugs (target 0)",
+                     best.foundPercent(), best.duplicates, best.curved_planes));
+  return true;
+}
 }  // namespace
 
 int main(int argc, char** argv)
 {
   Report report;
   std::vector<std::string> pcds;
+  std::string osd_dir;
   for (int i = 1; i < argc; ++i)
   {
     if (std::strcmp(argv[i], "--quick") == 0)
       report.quick = true;
+    else if (std::strcmp(argv[i], "--osd") == 0 && i + 1 < argc)
+      osd_dir = argv[++i];
     else if (report.out_dir.empty())
       report.out_dir = argv[i];
     else
@@ -644,7 +687,7 @@ int main(int argc, char** argv)
   }
   if (report.out_dir.empty())
   {
-    std::fprintf(stderr, "usage: evaluate_paper OUT_DIR [--quick] [FRAME.pcd ...]\n");
+    std::fprintf(stderr, "usage: evaluate_paper OUT_DIR [--quick] [--osd OSD_LEARN_DIR] [FRAME.pcd ...]\n");
     return 2;
   }
   const auto start = Clock::now();
@@ -657,6 +700,8 @@ int main(int argc, char** argv)
   std::fprintf(stderr, "Table 3's scenes along other paths\n");
   otherToursExperiment(report);
   if (!realFrames(report, pcds)) return 1;
+  std::fprintf(stderr, "osd-learn: real frames with annotated planes\n");
+  if (!osdLearnFrames(report, osd_dir)) return 1;
 
   std::ofstream out(report.out_dir + "/RESULTS.md");
   out << "# Results: the paper's experiments, regenerated\n\n"
