@@ -30,6 +30,20 @@ PointMoments centroidMoments(const PointMoments& block)
   return m;
 }
 
+PointMoments weightedCentroidMoments(const NormalEstimator& grid, const std::vector<BlockInfo>& info,
+                                     const std::vector<int>& blocks)
+{
+  const int bx_count = grid.blocksX();
+  PointMoments sum;
+  for (int b : blocks)
+  {
+    PointMoments m = centroidMoments(grid.block(b % bx_count, b / bx_count));
+    m.scale(info[b].fit_weight);
+    sum.add(m);
+  }
+  return sum;
+}
+
 void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, std::vector<BlockInfo>& info)
 {
   const int bx_count = grid.blocksX(), count = grid.blocksX() * grid.blocksY();
@@ -89,17 +103,8 @@ bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double
 
 bool BlockRegionGrower::fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const
 {
-  // Far points of a Kinect are an order of magnitude noisier than near ones: weight each
-  // block by the inverse variance of its depth so the precise points decide the fit.
   if (blocks.size() < 3) return false;
-  const int bx_count = grid_.blocksX();
-  PointMoments sum;
-  for (int b : blocks)
-  {
-    PointMoments m = centroidMoments(grid_.block(b % bx_count, b / bx_count));
-    m.scale(info_[b].fit_weight);
-    sum.add(m);
-  }
+  const PointMoments sum = weightedCentroidMoments(grid_, info_, blocks);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(sum.covariance());
   // Centroids along one line (a row of blocks) fix no plane.
@@ -127,18 +132,11 @@ std::vector<std::vector<int>> BlockRegionGrower::seedComponents(const Eigen::Vec
     std::vector<int> component(1, static_cast<int>(seed));
     mark_[seed] = generation_;
     for (size_t head = 0; head < component.size(); ++head)
-    {
-      const int b = component[head], bx = b % bx_count, by = b / bx_count;
-      const int neighbours[4][2] = {{bx - 1, by}, {bx + 1, by}, {bx, by - 1}, {bx, by + 1}};
-      for (const auto& n : neighbours)
-      {
-        if (n[0] < 0 || n[1] < 0 || n[0] >= bx_count || n[1] >= by_count) continue;
-        const int nb = n[1] * bx_count + n[0];
-        if (mark_[nb] != member) continue;
+      forEachNeighbour(component[head], bx_count, by_count, [&](int nb) {
+        if (mark_[nb] != member) return;
         mark_[nb] = generation_;
         component.push_back(nb);
-      }
-    }
+      });
     components.push_back(std::move(component));
   }
   std::sort(components.begin(), components.end(),
@@ -164,18 +162,11 @@ PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::V
     for (int b : region.blocks) mark_[b] = generation_;
     const size_t before = region.blocks.size();
     for (size_t head = 0; head < region.blocks.size(); ++head)
-    {
-      const int b = region.blocks[head], bx = b % bx_count, by = b / bx_count;
-      const int neighbours[4][2] = {{bx - 1, by}, {bx + 1, by}, {bx, by - 1}, {bx, by + 1}};
-      for (const auto& n : neighbours)
-      {
-        if (n[0] < 0 || n[1] < 0 || n[0] >= bx_count || n[1] >= by_count) continue;
-        const int nb = n[1] * bx_count + n[0];
-        if (mark_[nb] == generation_ || taken[nb]) continue;
+      forEachNeighbour(region.blocks[head], bx_count, by_count, [&](int nb) {
+        if (mark_[nb] == generation_ || taken[nb]) return;
         mark_[nb] = generation_;
         if (accepts(nb, region.normal, region.d)) region.blocks.push_back(nb);
-      }
-    }
+      });
     const bool grew = region.blocks.size() > before;
     fit(region.blocks, region.normal, region.d);
     if (!grew) break;

@@ -470,17 +470,7 @@ bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, si
 
 PointMoments PlaneDetector::weightedMoments(const std::vector<int>& blocks) const
 {
-  // Far points of a Kinect are an order of magnitude noisier than near ones: weight each
-  // block by the inverse variance of its depth so the precise points decide the fit.
-  const int bx_count = normals_.blocksX();
-  PointMoments sum;
-  for (int b : blocks)
-  {
-    PointMoments block = centroidMoments(normals_.block(b % bx_count, b / bx_count));
-    block.scale(block_info_[b].fit_weight);
-    sum.add(block);
-  }
-  return sum;
+  return weightedCentroidMoments(normals_, block_info_, blocks);
 }
 
 PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
@@ -501,18 +491,11 @@ PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks, double 
     component.assign(1, seed);
     visit_mark_[seed] = component_generation_;
     for (size_t head = 0; head < component.size(); ++head)
-    {
-      const int b = component[head], bx = b % bx_count, by = b / bx_count;
-      const int neighbours[4][2] = {{bx - 1, by}, {bx + 1, by}, {bx, by - 1}, {bx, by + 1}};
-      for (const auto& n : neighbours)
-      {
-        if (n[0] < 0 || n[1] < 0 || n[0] >= bx_count || n[1] >= by_count) continue;
-        const int nb = n[1] * bx_count + n[0];
-        if (member_mark_[nb] != component_generation_ || visit_mark_[nb] == component_generation_) continue;
+      forEachNeighbour(component[head], bx_count, by_count, [&](int nb) {
+        if (member_mark_[nb] != component_generation_ || visit_mark_[nb] == component_generation_) return;
         visit_mark_[nb] = component_generation_;
         component.push_back(nb);
-      }
-    }
+      });
     int x_min = bx_count, x_max = -1, y_min = by_count, y_max = -1;
     for (int b : component)
     {

@@ -34,9 +34,25 @@ struct BlockInfo
 // Fills `info` (row-major over the estimator's block grid) from the estimator's last frame.
 void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, std::vector<BlockInfo>& info);
 
+// Calls visit(neighbour) for each 4-neighbour of block b inside a bx_count x by_count grid.
+template <class Visit>
+void forEachNeighbour(int b, int bx_count, int by_count, Visit&& visit)
+{
+  const int bx = b % bx_count, by = b / bx_count;
+  if (bx > 0) visit(b - 1);
+  if (bx + 1 < bx_count) visit(b + 1);
+  if (by > 0) visit(b - bx_count);
+  if (by + 1 < by_count) visit(b + bx_count);
+}
+
 // A block's points all moved to their centroid: fits over many blocks then see the surface
 // without the depth noise inside blocks, which would tilt their normals toward the rays.
 PointMoments centroidMoments(const PointMoments& block);
+
+// Centroid moments of the blocks, each weighted by the inverse variance of the sensor at its
+// depth: far points of a Kinect are an order of magnitude noisier, the precise ones decide.
+PointMoments weightedCentroidMoments(const NormalEstimator& grid, const std::vector<BlockInfo>& info,
+                                     const std::vector<int>& blocks);
 
 struct PlaneRegion
 {
