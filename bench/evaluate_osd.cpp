@@ -1,5 +1,5 @@
 // The osd-learn section of make evaluate on its own, for quick checks while changing the
-// detector: evaluate_osd DIR [--no-pcl] [--misses] [--param-name VALUE ...]
+// detector: evaluate_osd DIR [--no-pcl] [--misses] [--pictures OUT_DIR] [--param-name VALUE ...]
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -13,12 +13,13 @@ int main(int argc, char** argv)
 {
   if (argc < 2)
   {
-    std::cerr << "usage: evaluate_osd DIR [--no-pcl] [--misses] [--PARAM VALUE ...]\n";
+    std::cerr << "usage: evaluate_osd DIR [--no-pcl] [--misses] [--pictures OUT_DIR] [--PARAM VALUE ...]\n";
     return 2;
   }
   const std::string dir = argv[1];
   DetectorParams params;
   bool with_pcl = true, misses = false;
+  std::string picture_dir;
   for (int i = 2; i < argc; ++i)
   {
     std::string arg = argv[i];
@@ -26,6 +27,8 @@ int main(int argc, char** argv)
       with_pcl = false;
     else if (arg == "--misses")
       misses = true;
+    else if (arg == "--pictures" && i + 1 < argc)
+      picture_dir = argv[++i];
     else if (arg.rfind("--", 0) == 0 && i + 1 < argc)
     {
       std::string name = arg.substr(2), error;
@@ -45,7 +48,7 @@ int main(int argc, char** argv)
   }
   OsdResults results;
   std::string error;
-  if (!evaluateOsdLearn(dir, params, with_pcl, "", results, &error))
+  if (!evaluateOsdLearn(dir, params, with_pcl, picture_dir, results, &error))
   {
     std::cerr << "evaluate_osd: " << error << "\n";
     return 1;

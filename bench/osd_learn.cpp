@@ -221,7 +221,7 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
   ransac.method = "PCL RANSAC (1 cm)";
   organized.method = "PCL OMPS";
   single.curved_planes = 0;
-  const std::set<std::string> picture_frames = {"learn0.pcd", "learn20.pcd", "learn28.pcd", "learn36.pcd"};
+  const std::set<std::string> picture_frames = {"learn0.pcd", "learn20.pcd", "learn28.pcd", "learn36.pcd", "learn40.pcd"};
   for (int index = 0;; ++index)
   {
     const std::string name = "learn" + std::to_string(index) + ".pcd";

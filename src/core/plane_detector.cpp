@@ -668,6 +668,7 @@ void PlaneDetector::growRegions(const std::vector<Peak>& peaks, std::vector<Peak
     refined.value = peak_value;
     refined.support = moments.count;
     refined.parallel = snapped;
+    refined.blocks = region.blocks;
     supported.push_back(refined);
   };
   constexpr size_t kMinSeedBlocks = 2;
@@ -1053,9 +1054,14 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
   }
   block_labels_.assign(static_cast<size_t>(normals_.blocksX()) * normals_.blocksY(), -1);
   block_claim_.clear();  // the map's planes are distinct: each takes its own windows' blocks
+  for (DetectedPlane& plane : planes_) plane.support = 0;
+  // A region of this frame labels its blocks with the map plane it is: its points are the
+  // measured support, also where a face is too small for any window.
+  if (params_.region_growing) labelRegionBlocks();
   std::vector<int> blocks;
   for (size_t p = 0; p < planes_.size(); ++p)
   {
+    if (planes_[p].support > 0) continue;
     const PointMoments moments = collectPlaneBlocks(planes_[p].normal, planes_[p].d, plane_windows[p], blocks);
     planes_[p].support = static_cast<int>(moments.count);
     for (int b : blocks) block_labels_[b] = planes_[p].id;
@@ -1090,6 +1096,36 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
     target->first->add(centroid, target->second->normal, target->second->d, frame_count_, fade);
   }
   extents_.swap(extents);
+}
+
+void PlaneDetector::labelRegionBlocks()
+{
+  block_claim_.assign(block_labels_.size(), 0);
+  const int bx_count = normals_.blocksX();
+  for (const Peak& peak : local_peaks_)
+  {
+    int best = -1;
+    double best_cost = 2.0;
+    for (size_t p = 0; p < planes_.size(); ++p)
+    {
+      const double sign = planes_[p].normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
+      const double cost = unsignedAngle(planes_[p].normal, peak.normal) / (params_.merge_angle + 1e-9) +
+                          std::abs(planes_[p].d - sign * peak.d) / (params_.merge_distance + 1e-9);
+      if (cost < best_cost)
+      {
+        best_cost = cost;
+        best = static_cast<int>(p);
+      }
+    }
+    if (best < 0) continue;
+    for (int b : peak.blocks)
+    {
+      if (block_claim_[b]) continue;
+      block_claim_[b] = 1;
+      block_labels_[b] = planes_[best].id;
+      planes_[best].support += static_cast<int>(normals_.block(b % bx_count, b / bx_count).count);
+    }
+  }
 }
 
 const PlaneExtent* PlaneDetector::extent(int id) const

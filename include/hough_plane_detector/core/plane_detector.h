@@ -148,6 +148,7 @@ private:
     double value;
     double support = 0.0;  // points of the frame on the refined per-frame plane
     bool parallel = false;  // with a known plane's normal: the parallel search's, or snapped to it
+    std::vector<int> blocks;  // region_growing: the blocks of its region
   };
 
   void vote();
@@ -158,6 +159,9 @@ private:
   // region_growing: each peak seeds block regions grown on their refitted planes; then the
   // flat blocks left seed regions of their own.
   void growRegions(const std::vector<Peak>& peaks, std::vector<Peak>& supported);
+  // region_growing: labels each accepted region's blocks with the map plane it matches, whose
+  // support they become; blocks taken this way are claimed for the windows' labelling after it.
+  void labelRegionBlocks();
   void updateGlobal(const Eigen::Vector3d& camera_position, double stamp);
   // Climbs from a cell to the local maximum under the (value, -index) total order.
   Eigen::Vector3i climb(const SparseHoughSpace& space, Eigen::Vector3i cell) const;
