@@ -649,3 +649,34 @@ TEST(PlaneDetector, RegionGrowingFindsBoxFacesTooSmallForAWindowsVote)
   EXPECT_EQ(regions, 3) << with_regions;
   EXPECT_LT(windows, regions) << "the windows' fit found as many faces:" << with_windows;
 }
+
+// The same curved clutter with region_growing: regions on pillars and balls are refused
+// because their blocks' normals turn (kCurvedPatches), and regions whose rays graze their
+// plane (a band through the sensor) as edge-on (kEdgeOn); the map holds the floor alone.
+TEST(PlaneDetector, RegionGrowingRefusesCurvedAndEdgeOnRegions)
+{
+  Scene scene;
+  scene.addRectangle({0, 0, 0}, kX, kY, 8.0, 8.0, "floor");
+  scene.cylinders.push_back({{2.0, -0.6, 0.0}, 0.25, 1.5});
+  scene.cylinders.push_back({{2.5, 0.7, 0.0}, 0.4, 2.0});
+  scene.cylinders.push_back({{1.5, 0.3, 0.0}, 0.12, 1.0});
+  scene.spheres.push_back({{1.6, -0.1, 1.3}, 0.3});
+  scene.spheres.push_back({{3.2, -0.2, 0.5}, 0.5});
+  SceneRenderer renderer(scene);
+  DetectorParams params;
+  params.region_growing = 1;
+  PlaneDetector detector(params);
+  std::map<CandidateVerdict, int> refused;
+  for (int f = 0; f < 20; ++f)
+  {
+    const Eigen::Isometry3d pose = lookAt({0.02 * f, 0.05 * std::sin(0.3 * f), 1.2}, {2.5, 0.0, 0.6});
+    feed(detector, renderer.render(pose, kinect(1.0), 200 + f), f);
+    for (const auto& p : detector.planes())
+      EXPECT_FALSE(matching({p}, kZ, 0.0, 0.02, 0.03).empty()) << "frame " << f << ": plane that is not the floor"
+                                                               << describe({p});
+    for (const PlaneCandidate& c : detector.lastCandidates())
+      if (c.verdict != CandidateVerdict::kAccepted) ++refused[c.verdict];
+  }
+  EXPECT_GT(refused[CandidateVerdict::kCurvedPatches], 0);
+  EXPECT_GT(refused[CandidateVerdict::kEdgeOn], 0);
+}

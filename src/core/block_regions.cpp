@@ -12,7 +12,11 @@ namespace
 {
 constexpr double kMinBlockSigma = 0.001;   // m: no block is judged flatter than a millimetre
 constexpr double kMaxNormalTolerance = 1.0;  // rad: a block's normal is never trusted less than this
-constexpr double kMaxThicknessRatio = 0.25;  // noise variance over in-plane spread: beyond, no normal
+constexpr double kMaxThicknessRatio = 0.25;
+constexpr double kMinRaySine = 0.1;  // rays at least ~6 deg to a plane
+// A surface bending more than this (1/m: radius 0.5 m) is not a plane; cardboard faces and
+// warped walls bend far less, pillars, balls and cans more.
+constexpr double kMaxPlaneCurvature = 2.0;  // noise variance over in-plane spread: beyond, no normal
 // Depth error that does not average out over a block (calibration residue of structured
 // light, surfaces a little off flat), per squared metre of depth: 1.5 mm at 1 m.
 constexpr double kSystematicPerSquareMetre = 0.0015;
@@ -98,7 +102,112 @@ bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double
   const BlockInfo& i = info_[block];
   if (!i.planar) return false;
   if (std::abs(i.normal.dot(normal)) < std::cos(i.normal_tolerance)) return false;
+  // Rays that graze a plane move along it with their depth error, so any surface they hit
+  // lies "on" it: a plane seen edge-on cannot be tested, and no block joins it that way.
+  if (std::abs(normal.dot(i.centroid.normalized())) < kMinRaySine) return false;
   return std::abs(normal.dot(i.centroid) + d) <= std::min(params_.support_distance, i.region_residual);
+}
+
+bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
+{
+  size_t grazing = 0;
+  for (int b : blocks) grazing += std::abs(normal.dot(info_[b].centroid.normalized())) < kMinRaySine;
+  return 2 * grazing > blocks.size();
+}
+
+bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const
+{
+  constexpr double kChi2DropThreeDof = 16.27;  // p = 0.001
+  if (blocks.size() < 12) return false;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int b : blocks) mean += info_[b].centroid;
+  mean /= blocks.size();
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  // Weighted least squares of the residual r = [1 u v u^2 uv v^2] c; the plane is the first three.
+  Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+  double chi2_plane = 0.0, rr = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& i = info_[b];
+    const double sigma = i.region_residual / 3.0, w = 1.0 / (sigma * sigma);
+    const double x = (i.centroid - mean).dot(u), y = (i.centroid - mean).dot(v);
+    const double r = normal.dot(i.centroid) + d;
+    Eigen::Matrix<double, 6, 1> a;
+    a << 1.0, x, y, x * x, x * y, y * y;
+    normal_matrix += w * a * a.transpose();
+    rhs += w * r * a;
+    rr += w * r * r;
+  }
+  // The plane's own fit (first three terms) against the quadric's.
+  const Eigen::Vector3d plane = normal_matrix.topLeftCorner<3, 3>().ldlt().solve(rhs.head<3>());
+  chi2_plane = rr - rhs.head<3>().dot(plane);
+  const Eigen::Matrix<double, 6, 1> quadric = normal_matrix.ldlt().solve(rhs);
+  const double chi2_quadric = rr - rhs.dot(quadric);
+  if (!(chi2_plane - chi2_quadric > kChi2DropThreeDof)) return false;
+  Eigen::Matrix2d hessian;
+  hessian << 2.0 * quadric(3), quadric(4), quadric(4), 2.0 * quadric(5);
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(hessian).eigenvalues().cwiseAbs().maxCoeff() > kMaxPlaneCurvature;
+}
+
+bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
+{
+  // Mean normal of each half (split across either in-plane axis), from the blocks whose own
+  // normal is informative; their difference against its standard error from the scatter.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  int informative = 0;
+  for (int b : blocks)
+    if (info_[b].normal_tolerance < M_PI / 2)
+    {
+      mean += info_[b].centroid;
+      ++informative;
+    }
+  constexpr int kMinHalfBlocks = 3;
+  if (informative < 2 * kMinHalfBlocks) return false;
+  mean /= informative;
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+  for (int b : blocks)
+    if (info_[b].normal_tolerance < M_PI / 2)
+    {
+      const Eigen::Vector2d p((info_[b].centroid - mean).dot(u), (info_[b].centroid - mean).dot(v));
+      spread += p * p.transpose();
+    }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> axes(spread);
+  for (int a = 0; a < 2; ++a)
+  {
+    const Eigen::Vector3d axis = axes.eigenvectors()(0, a) * u + axes.eigenvectors()(1, a) * v;
+    Eigen::Vector3d sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    Eigen::Vector3d where[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    double square[2] = {0.0, 0.0};
+    int count[2] = {0, 0};
+    for (int b : blocks)
+    {
+      const BlockInfo& i = info_[b];
+      if (i.normal_tolerance >= M_PI / 2) continue;
+      const int h = axis.dot(i.centroid - mean) >= 0.0 ? 1 : 0;
+      const Eigen::Vector3d n = i.normal.dot(normal) >= 0.0 ? i.normal : Eigen::Vector3d(-i.normal);
+      sum[h] += n;
+      square[h] += n.squaredNorm();
+      where[h] += i.centroid;
+      ++count[h];
+    }
+    if (count[0] < kMinHalfBlocks || count[1] < kMinHalfBlocks) continue;
+    double error_variance = 0.0;
+    Eigen::Vector3d half_normal[2];
+    for (int h = 0; h < 2; ++h)
+    {
+      const Eigen::Vector3d m = sum[h] / count[h];
+      // Variance of the mean normal: the normals' own scatter over their number.
+      error_variance += std::max(0.0, square[h] / count[h] - m.squaredNorm()) / (count[h] - 1);
+      half_normal[h] = m.normalized();
+      where[h] /= count[h];
+    }
+    const double tilt = std::acos(std::min(1.0, half_normal[0].dot(half_normal[1])));
+    const double separation = (where[1] - where[0]).norm();
+    if (tilt > 3.0 * std::sqrt(error_variance) && tilt > kMaxPlaneCurvature * separation) return true;
+  }
+  return false;
 }
 
 bool BlockRegionGrower::fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const
@@ -170,6 +279,17 @@ PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::V
     const bool grew = region.blocks.size() > before;
     fit(region.blocks, region.normal, region.d);
     if (!grew) break;
+  }
+  // Blocks that joined at the plane's first guess but lie beyond two sigmas of the final fit
+  // (edges where a riser meets a tread) would tilt it: the fit is made again without them.
+  for (int pass = 0; pass < 2; ++pass)
+  {
+    std::vector<int> inliers;
+    for (int b : region.blocks)
+      if (std::abs(region.normal.dot(info_[b].centroid) + region.d) <= (2.0 / 3.0) * info_[b].region_residual)
+        inliers.push_back(b);
+    if (inliers.size() == region.blocks.size() || !fit(inliers, region.normal, region.d)) break;
+    region.blocks.swap(inliers);
   }
   for (int b : region.blocks) region.points += grid_.block(b % bx_count, b / bx_count).count;
   return region;

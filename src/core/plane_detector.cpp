@@ -67,6 +67,7 @@ const char* toString(CandidateVerdict verdict)
     case CandidateVerdict::kCentroidsOffPlane: return "centroids off the plane";
     case CandidateVerdict::kHalvesDisagree: return "halves disagree";
     case CandidateVerdict::kNotParallel: return "not parallel to the known plane";
+    case CandidateVerdict::kEdgeOn: return "seen edge-on";
   }
   return "unknown";
 }
@@ -651,6 +652,12 @@ void PlaneDetector::growRegions(const std::vector<Peak>& peaks, std::vector<Peak
       verdict = CandidateVerdict::kCurvedPatches;
     else if (!grower.fit(region.blocks, region.normal, region.d))
       verdict = CandidateVerdict::kTooFewPoints;
+    else if (grower.seenEdgeOn(region.blocks, region.normal))
+      verdict = CandidateVerdict::kEdgeOn;
+    else if (grower.normalsTurn(region.blocks, region.normal))
+      verdict = CandidateVerdict::kCurvedPatches;
+    else if (grower.centroidsBend(region.blocks, region.normal, region.d))
+      verdict = CandidateVerdict::kCurvedPatches;
     else if (!isPlanarFit(weightedMoments(region.blocks), region.blocks))
       verdict = CandidateVerdict::kCentroidsOffPlane;
     else if (!halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))

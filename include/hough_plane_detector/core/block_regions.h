@@ -75,6 +75,15 @@ public:
   PlaneRegion grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
   // True when the block may join a region of plane (normal, d).
   bool accepts(int block, const Eigen::Vector3d& normal, double d) const;
+  // True when the rays to most of the blocks graze the plane (under ~6 deg).
+  bool seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
+  // True when the block centroids bend away from the plane: a quadric fit explains them
+  // significantly better (chi^2 drop over 3 degrees of freedom, p < 0.001) and its larger
+  // principal curvature exceeds what a plane may have (a pillar's, a ball's or a can's side).
+  bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
+  // True when the blocks' own normals turn across the region, significantly beyond their
+  // measured scatter and by more than a plane's curvature may be (a pillar's or can's side).
+  bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // Weighted least-squares plane of the blocks' centroids; false when they fix no plane.
   bool fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
 

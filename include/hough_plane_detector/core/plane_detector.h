@@ -44,6 +44,7 @@ enum class CandidateVerdict
   kCentroidsOffPlane,  // block centroids scatter more than the sensor noise allows (chi^2)
   kHalvesDisagree,     // the fits of its two halves differ by more than merge_angle
   kNotParallel,        // parallel search: its blocks' own fit is not parallel to the known plane
+  kEdgeOn,             // region: most rays graze its plane, which their depths cannot test
 };
 const char* toString(CandidateVerdict verdict);
 
