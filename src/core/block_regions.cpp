@@ -284,12 +284,14 @@ PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::V
   // (edges where a riser meets a tread) would tilt it: the fit is made again without them.
   for (int pass = 0; pass < 2; ++pass)
   {
-    std::vector<int> inliers;
+    std::vector<int> inliers, outliers;
     for (int b : region.blocks)
-      if (std::abs(region.normal.dot(info_[b].centroid) + region.d) <= (2.0 / 3.0) * info_[b].region_residual)
-        inliers.push_back(b);
-    if (inliers.size() == region.blocks.size() || !fit(inliers, region.normal, region.d)) break;
+      (std::abs(region.normal.dot(info_[b].centroid) + region.d) <= (2.0 / 3.0) * info_[b].region_residual ? inliers
+                                                                                                              : outliers)
+          .push_back(b);
+    if (outliers.empty() || !fit(inliers, region.normal, region.d)) break;
     region.blocks.swap(inliers);
+    region.trimmed.insert(region.trimmed.end(), outliers.begin(), outliers.end());
   }
   for (int b : region.blocks) region.points += grid_.block(b % bx_count, b / bx_count).count;
   return region;

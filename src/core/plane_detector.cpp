@@ -644,6 +644,7 @@ void PlaneDetector::growRegions(const std::vector<Peak>& peaks, std::vector<Peak
   auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
     PlaneRegion region = grower.grow(seed, n_cam, d_cam, block_claim_);
     for (int b : region.blocks) tried[b] = 1;
+    for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
     CandidateVerdict verdict = CandidateVerdict::kAccepted;
     PointMoments moments;
     if (region.points < std::max(3, params_.min_support))

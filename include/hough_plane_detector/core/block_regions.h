@@ -57,6 +57,7 @@ PointMoments weightedCentroidMoments(const NormalEstimator& grid, const std::vec
 struct PlaneRegion
 {
   std::vector<int> blocks;
+  std::vector<int> trimmed;  // joined while growing, beyond two sigmas of the final plane
   double points = 0;
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // camera frame, weighted fit of the centroids
   double d = 0;
