@@ -24,6 +24,7 @@
 #include "hough_plane_detector/core/plane_metrics.h"
 #include "hough_plane_detector/core/scene_renderer.h"
 #include "hough_plane_detector/tools/input_sources.h"
+#include "hough_plane_detector/sim/random_scene.h"
 #include "osd_learn.h"
 #include "pcl_comparators.h"
 
@@ -621,6 +622,80 @@ void regionGrowingTours(Report& report)
                      regions.detectionPercent(), windows.detectionPercent(), regions.falsePerFrame()));
 }
 
+// Procedural rooms (sim/random_scene.h): the held-out seeds decide, the tuning seeds are shown
+// beside them. Ours only (windows and region_growing), every 3rd frame from frame 3.
+void randomSceneExperiment(Report& report)
+{
+  const int frames = report.quick ? 12 : 30;
+  const size_t held_out_count = report.quick ? 5 : kHeldOutSeeds.size();
+  const size_t tuning_count = report.quick ? 3 : kTuningSeeds.size();
+  struct SetStats
+  {
+    MethodStats windows, regions;
+  } held_out, tuning;
+  std::string rows;
+  auto runSeed = [&](uint32_t seed, SetStats& set, bool row) {
+    const RandomScene room = makeRandomScene(seed, frames);
+    const SceneRenderer renderer(room.scene);
+    DetectorParams params = paramsFor(room.noise, 1024);
+    PlaneDetector windows(params);
+    params.region_growing = 1;
+    PlaneDetector regions(params);
+    MethodStats w, r;
+    KinectNoise noise;
+    noise.coefficient = room.noise;
+    for (int f = 0; f < frames; ++f)
+    {
+      const RenderedFrame frame = renderer.render(room.poses[f], noise, seed * 1000 + f);
+      windows.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
+      regions.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
+      if (f < kWarmupFrames || (f - kWarmupFrames) % 3 != 0) continue;
+      w.add(evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints, mapPlanes(windows)));
+      r.add(evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints, mapPlanes(regions)));
+    }
+    if (row)
+      rows += fmt("| %u | %s | %.1f %% | %.2f | %.1f %% | %.2f |\n", seed, room.description.c_str(), w.detectionPercent(),
+                  w.falsePerFrame(), r.detectionPercent(), r.falsePerFrame());
+    set.windows.merge(w);
+    set.regions.merge(r);
+  };
+  for (size_t i = 0; i < tuning_count; ++i)
+  {
+    std::fprintf(stderr, "  tuning seed %u\n", kTuningSeeds[i]);
+    runSeed(kTuningSeeds[i], tuning, false);
+  }
+  for (size_t i = 0; i < held_out_count; ++i)
+  {
+    std::fprintf(stderr, "  held-out seed %u\n", kHeldOutSeeds[i]);
+    runSeed(kHeldOutSeeds[i], held_out, true);
+  }
+  std::string table = "| seeds | per-frame stage | E_angle (rad) | E_d (m) | detected | false / frame | frames |\n"
+                      "|---|---|---|---|---|---|---|\n";
+  table += fmt("| %zu held-out ", held_out_count) + accuracyRow("**windows (default)**", held_out.windows);
+  table += fmt("| %zu held-out ", held_out_count) + accuracyRow("region_growing 1", held_out.regions);
+  table += fmt("| %zu tuning ", tuning_count) + accuracyRow("windows (default)", tuning.windows);
+  table += fmt("| %zu tuning ", tuning_count) + accuracyRow("region_growing 1", tuning.regions);
+  report.md << "## Procedural rooms: held-out seeds\n\n"
+            << fmt("Rooms from `makeRandomScene` (src/sim/random_scene.cpp): random size (4-8 x 3.5-7 x 2.4-3.2 m) "
+                   "and yaw; by chance stairs (rise 12-20 cm, run 25-35 cm), a ramp (5-20 deg), a ceiling sloping "
+                   "20-45 deg, shelving with boards 30-40 cm apart, a door open 30-80 deg; always 1-2 tables, 2-5 boxes "
+                   "at random yaw (some stacked), cylinders and balls; a camera circling at 0.8-1.6 m, 10-35 deg down; "
+                   "eq. 11 noise with C drawn from 0.5-2 (the detector's sensor_noise = max(1, C)). %d frames a room, "
+                   "scored every 3rd from frame %d as Table 3. The held-out seeds (101-120) were written down before "
+                   "any threshold was chosen on these rooms and are reported only; tuning looks at seeds 901-908 "
+                   "only. Targets on the held-out seeds (C = 0.5-2 here, not C = 1 alone): >= 95 %% detected, <= "
+                   "0.05 false planes per frame, E_angle <= 0.01 rad, E_d <= 1 cm.\n\n",
+                   frames, kWarmupFrames)
+            << table << "\n| held-out seed | room | windows detected | false / frame | region_growing detected | "
+                        "false / frame |\n|---|---|---|---|---|---|\n"
+            << rows << '\n';
+  const MethodStats& h = held_out.windows;
+  report.verdict(h.detectionPercent() >= 95.0 && h.falsePerFrame() <= 0.05 && mean(h.angle) <= 0.01 && mean(h.d) <= 0.01,
+                 fmt("held-out procedural rooms (defaults): %.1f %% detected >= 95 %%, %.3f false planes per frame <= "
+                     "0.05, E_angle %.4f rad, E_d %.4f m",
+                     h.detectionPercent(), h.falsePerFrame(), mean(h.angle), mean(h.d)));
+}
+
 // ../shared/data/kinect-real: a still camera, no ground truth; time and planes found.
 bool realFrames(Report& report, const std::vector<std::string>& paths)
 {
@@ -734,6 +809,8 @@ int main(int argc, char** argv)
   std::fprintf(stderr, "Table 3's scenes along other paths\n");
   otherToursExperiment(report);
   if (!realFrames(report, pcds)) return 1;
+  std::fprintf(stderr, "Procedural rooms: held-out seeds\n");
+  randomSceneExperiment(report);
   std::fprintf(stderr, "Table 3's tours with region_growing\n");
   regionGrowingTours(report);
   std::fprintf(stderr, "osd-learn: real frames with annotated planes\n");
