@@ -280,6 +280,27 @@ PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::V
     fit(region.blocks, region.normal, region.d);
     if (!grew) break;
   }
+  // The plane of the region's interior (blocks whose four neighbours are in it): blocks on its
+  // rim may straddle the fold to a neighbouring surface (a stair's nosing) and tilt the fit.
+  {
+    ++generation_;
+    for (int b : region.blocks) mark_[b] = generation_;
+    std::vector<int> interior;
+    for (int b : region.blocks)
+    {
+      int inside = 0;
+      forEachNeighbour(b, bx_count, by_count, [&](int nb) { inside += mark_[nb] == generation_; });
+      if (inside == 4) interior.push_back(b);
+    }
+    constexpr size_t kMinInteriorBlocks = 6;
+    Eigen::Vector3d n = region.normal;
+    double interior_d = region.d;
+    if (interior.size() >= kMinInteriorBlocks && fit(interior, n, interior_d))
+    {
+      region.normal = n;
+      region.d = interior_d;
+    }
+  }
   // Blocks that joined at the plane's first guess but lie beyond two sigmas of the final fit
   // (edges where a riser meets a tread) would tilt it: the fit is made again without them.
   for (int pass = 0; pass < 2; ++pass)
