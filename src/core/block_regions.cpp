@@ -73,6 +73,7 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, s
     const double systematic = kSystematicPerSquareMetre * i.centroid.z() * i.centroid.z();
     const double block_sigma = std::max(kMinBlockSigma, sigma);
     i.region_residual = 3.0 * std::sqrt(block_sigma * block_sigma / block.count + step * step / 12.0 + systematic * systematic);
+    if (!params.region_growing) continue;  // the windows' fit needs no block normals
     solver.computeDirect(i.covariance);
     i.normal = solver.eigenvectors().col(0);
     if (i.normal.dot(i.centroid) > 0.0) i.normal = -i.normal;
@@ -147,7 +148,9 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
   if (!(chi2_plane - chi2_quadric > kChi2DropThreeDof)) return false;
   Eigen::Matrix2d hessian;
   hessian << 2.0 * quadric(3), quadric(4), quadric(4), 2.0 * quadric(5);
-  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(hessian).eigenvalues().cwiseAbs().maxCoeff() > kMaxPlaneCurvature;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> curvatures;
+  curvatures.computeDirect(hessian);
+  return curvatures.eigenvalues().cwiseAbs().maxCoeff() > kMaxPlaneCurvature;
 }
 
 bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
@@ -173,7 +176,8 @@ bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen:
       const Eigen::Vector2d p((info_[b].centroid - mean).dot(u), (info_[b].centroid - mean).dot(v));
       spread += p * p.transpose();
     }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> axes(spread);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> axes;
+  axes.computeDirect(spread);
   for (int a = 0; a < 2; ++a)
   {
     const Eigen::Vector3d axis = axes.eigenvectors()(0, a) * u + axes.eigenvectors()(1, a) * v;
