@@ -12,6 +12,11 @@ packages=(
   python3-dynamic-reconfigure libdiagnostic-updater-dev libmessage-filters-dev libpcl-conversions-dev libpng-dev nlohmann-json3-dev libopenni2-dev clang libclang-rt-14-dev
   ros-std-srvs ros-shape-msgs ros-visualization-msgs ros-diagnostic-msgs ros-message-runtime
   python3-roslaunch python3-rosmaster python3-rospy rosout tf2-tools rosbash
+  # What a ROS user reaches for first: rostopic echo/hz, rosservice call, rosnode, rosparam, and
+  # the Python bindings of every message this package's messages and topics use.
+  python3-rostopic python3-rosservice python3-rosnode python3-rosparam python3-std-msgs
+  python3-geometry-msgs python3-shape-msgs python3-sensor-msgs python3-visualization-msgs
+  python3-std-srvs python3-diagnostic-msgs
 )
 # Extra packages a target needs beyond these (make evaluate: gnuplot-nox).
 packages+=("$@")

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -18,6 +17,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/tools/cli_options.h"
 #include "test_bags.h"
 
 using namespace hough_plane_detector;
@@ -185,4 +185,46 @@ TEST(DetectPlanesCli, ReadsPcdFilesAsAStillCamera)
   const RunResult missing = run(tempPath("absent.pcd"));
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.output.find("cannot open"), std::string::npos) << missing.output;
+}
+
+// Stamps of real recordings (seconds since 1970) and every number read back exactly.
+TEST(DetectPlanesCli, JsonNumbersRoundTrip)
+{
+  DetectedPlane plane;
+  plane.id = 7;
+  plane.normal = Eigen::Vector3d(0.1234567890123, -0.2, 0.9).normalized();
+  plane.d = -1.23456789012345;
+  plane.strength = 3.5;
+  plane.support = 123456;
+  const double stamp = 1764000000.123456;
+  const nlohmann::json frame = nlohmann::json::parse(frameToJson(3, stamp, "od\"om\n", 2.5, {plane}));
+  EXPECT_EQ(frame.at("stamp").get<double>(), stamp);
+  EXPECT_EQ(frame.at("frame_id").get<std::string>(), "od\"om\n");
+  EXPECT_EQ(frame.at("planes")[0].at("d").get<double>(), plane.d);
+  EXPECT_EQ(frame.at("planes")[0].at("normal")[0].get<double>(), plane.normal.x());
+  EXPECT_EQ(frame.at("planes")[0].at("support").get<int>(), 123456);
+}
+
+// A file whose header is not a PCD header is refused by name before PCL's reader sees it
+// (PCL 1.13 crashed on one line of text).
+TEST(DetectPlanesCli, RefusesFilesThatAreNotPcd)
+{
+  const std::string text = tempPath("notes.pcd");
+  std::ofstream(text) << "remember to buy milk\n";
+  RunResult r = run(text);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("not a PCD header"), std::string::npos) << r.output;
+
+  const std::string no_points = tempPath("nopoints.pcd");
+  std::ofstream(no_points) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 2\n"
+                              "DATA ascii\n0 0 1\n0 0 1\n0 0 1\n0 0 1\n";
+  r = run(no_points);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("no POINTS"), std::string::npos) << r.output;
+
+  const std::string mismatch = tempPath("mismatch.pcd");
+  std::ofstream(mismatch) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 2\nPOINTS 4\nDATA ascii\n";
+  r = run(mismatch);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("differ in number"), std::string::npos) << r.output;
 }

@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <mutex>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -131,6 +132,32 @@ TEST(Pipeline, FindsTheRoomsPlanesWithExtentsAndMarkers)
   int patches = 0;
   for (const auto& m : markers) patches += m.ns == "patches" && m.type == visualization_msgs::Marker::TRIANGLE_LIST;
   EXPECT_GE(patches, 5);
+}
+
+// A map server's outputs are latched by default, so rviz or a node started later gets the map.
+TEST(Pipeline, PlanesAndMarkersAreLatched)
+{
+  ros::NodeHandle nh;
+  std::mutex mutex;
+  std::condition_variable received;
+  std::map<std::string, std::string> latching;  // topic -> the publisher's "latching" header
+  auto remember = [&](const std::string& topic, const ros::M_string& header) {
+    std::lock_guard<std::mutex> lock(mutex);
+    const auto it = header.find("latching");
+    latching[topic] = it == header.end() ? "" : it->second;
+    received.notify_all();
+  };
+  const boost::function<void(const ros::MessageEvent<PlaneArray const>&)> on_planes =
+      [&](const ros::MessageEvent<PlaneArray const>& e) { remember("planes", e.getConnectionHeader()); };
+  const boost::function<void(const ros::MessageEvent<visualization_msgs::MarkerArray const>&)> on_markers =
+      [&](const ros::MessageEvent<visualization_msgs::MarkerArray const>& e) { remember("markers", e.getConnectionHeader()); };
+  const ros::Subscriber planes = nh.subscribe<const ros::MessageEvent<PlaneArray const>&>(kNode + "/planes", 1, on_planes);
+  const ros::Subscriber markers =
+      nh.subscribe<const ros::MessageEvent<visualization_msgs::MarkerArray const>&>(kNode + "/markers", 1, on_markers);
+  std::unique_lock<std::mutex> lock(mutex);
+  ASSERT_TRUE(received.wait_for(lock, std::chrono::seconds(30), [&] { return latching.size() == 2; }));
+  EXPECT_EQ(latching["planes"], "1");
+  EXPECT_EQ(latching["markers"], "1");
 }
 
 TEST(Pipeline, ResetClearsPlanesAndMarkers)

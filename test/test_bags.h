@@ -3,11 +3,11 @@
 #pragma once
 
 #include <cstring>
-#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <Eigen/Geometry>
 #include <rosbag/bag.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -112,21 +112,22 @@ struct JsonPlane
   double d;
 };
 
+// The frames of detect_planes' JSON lines (other lines, such as warnings, are skipped).
 inline std::vector<std::vector<JsonPlane>> parseFrames(const std::string& output, std::vector<std::string>* frame_ids = nullptr)
 {
   std::vector<std::vector<JsonPlane>> frames;
-  const std::regex plane_re(R"re("normal": \[([-0-9.e]+), ([-0-9.e]+), ([-0-9.e]+)\], "d": ([-0-9.e]+))re");
-  const std::regex frame_re(R"re(^\{"frame": \d+, "stamp": [-0-9.e]+, "frame_id": "([^"]*)", "ms": [0-9.e]+, "planes": \[)re");
   std::istringstream lines(output);
   std::string line;
   while (std::getline(lines, line))
   {
-    std::smatch m;
-    if (!std::regex_search(line, m, frame_re)) continue;
-    if (frame_ids) frame_ids->push_back(m[1]);
+    const nlohmann::json frame = nlohmann::json::parse(line, nullptr, false);
+    if (frame.is_discarded() || !frame.is_object() || !frame.contains("planes")) continue;
+    if (frame_ids) frame_ids->push_back(frame.at("frame_id").get<std::string>());
     std::vector<JsonPlane> planes;
-    for (auto it = std::sregex_iterator(line.begin(), line.end(), plane_re); it != std::sregex_iterator(); ++it)
-      planes.push_back({Eigen::Vector3d(std::stod((*it)[1]), std::stod((*it)[2]), std::stod((*it)[3])), std::stod((*it)[4])});
+    for (const auto& p : frame.at("planes"))
+      planes.push_back({Eigen::Vector3d(p.at("normal")[0].get<double>(), p.at("normal")[1].get<double>(),
+                                        p.at("normal")[2].get<double>()),
+                        p.at("d").get<double>()});
     frames.push_back(planes);
   }
   return frames;

@@ -69,7 +69,7 @@ private:
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& private_nh = getPrivateNodeHandle();
     private_nh.param<std::string>("world_frame", world_frame_, "odom");
-    private_nh.param("latch", latch_, false);
+    private_nh.param("latch", latch_, true);  // a map server: late subscribers get the map
     int queue_size;
     private_nh.param("queue_size", queue_size, 2);
     // tf2's filter waits for tf data this much newer than a cloud; a clouds' queue must hold
@@ -382,7 +382,7 @@ private:
   std::unique_ptr<PlaneDetector> detector_;
   DetectorParams params_;
   std::string world_frame_;
-  bool latch_ = false;
+  bool latch_ = true;
   ros::Time last_stamp_;
   double last_ms_ = 0.0;
   int frames_processed_ = 0, frames_dropped_ = 0, frames_rejected_ = 0;

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 namespace hough_plane_detector
 {
 
@@ -42,29 +44,6 @@ std::string number(double v)
   return buf;
 }
 
-std::string escapeJson(const std::string& s)
-{
-  std::string out;
-  for (char c : s)
-  {
-    if (c == '"' || c == '\\')
-    {
-      out += '\\';
-      out += c;
-    }
-    else if (static_cast<unsigned char>(c) < 0x20)
-    {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-      out += buf;
-    }
-    else
-    {
-      out += c;
-    }
-  }
-  return out;
-}
 }  // namespace
 
 bool setDetectorParam(DetectorParams& params, const std::string& name, const std::string& value, std::string* error)
@@ -118,18 +97,25 @@ std::vector<std::string> detectorParamHelp()
 std::string frameToJson(int frame, double stamp, const std::string& frame_id, double ms,
                         const std::vector<DetectedPlane>& planes)
 {
-  std::ostringstream out;
-  out << "{\"frame\": " << frame << ", \"stamp\": " << number(stamp) << ", \"frame_id\": \"" << escapeJson(frame_id)
-      << "\", \"ms\": " << number(ms) << ", \"planes\": [";
-  for (size_t i = 0; i < planes.size(); ++i)
+  // nlohmann::json prints doubles so that they read back exactly (a 2025 stamp keeps its
+  // microseconds) and escapes strings; a non-finite number becomes null.
+  nlohmann::ordered_json out;
+  out["frame"] = frame;
+  out["stamp"] = stamp;
+  out["frame_id"] = frame_id;
+  out["ms"] = ms;
+  out["planes"] = nlohmann::ordered_json::array();
+  for (const DetectedPlane& p : planes)
   {
-    const DetectedPlane& p = planes[i];
-    out << (i ? ", " : "") << "{\"id\": " << p.id << ", \"normal\": [" << number(p.normal.x()) << ", "
-        << number(p.normal.y()) << ", " << number(p.normal.z()) << "], \"d\": " << number(p.d)
-        << ", \"strength\": " << number(p.strength) << ", \"support\": " << p.support << "}";
+    nlohmann::ordered_json plane;
+    plane["id"] = p.id;
+    plane["normal"] = {p.normal.x(), p.normal.y(), p.normal.z()};
+    plane["d"] = p.d;
+    plane["strength"] = p.strength;
+    plane["support"] = p.support;
+    out["planes"].push_back(plane);
   }
-  out << "]}";
-  return out.str();
+  return out.dump();
 }
 
 }  // namespace hough_plane_detector
