@@ -61,6 +61,15 @@ public:
     if (cloud_spinner_) cloud_spinner_->stop();
     tf_filter_.reset();
     subscriber_.reset();
+    if (!save_on_shutdown_.empty() && detector_)
+    {
+      std::lock_guard<std::mutex> lock(map_mutex_);
+      std::string error;
+      if (detector_->saveMap(save_on_shutdown_, &error))
+        NODELET_INFO("Saved %zu planes to ~save_on_shutdown %s.", detector_->planes().size(), save_on_shutdown_.c_str());
+      else
+        NODELET_ERROR("~save_on_shutdown %s: %s", save_on_shutdown_.c_str(), error.c_str());
+    }
   }
 
 private:
@@ -91,6 +100,18 @@ private:
       params_ = DetectorParams();
     }
     detector_.reset(new PlaneDetector(params_));
+    // A map server: the map of the last run, and where this run's map goes at shutdown.
+    std::string map_file;
+    private_nh.param<std::string>("map_file", map_file, "");
+    private_nh.param<std::string>("save_on_shutdown", save_on_shutdown_, "");
+    if (!map_file.empty())
+    {
+      std::string error;
+      if (detector_->loadMap(map_file, &error))
+        NODELET_INFO("Loaded %zu planes from ~map_file %s.", detector_->planes().size(), map_file.c_str());
+      else
+        NODELET_ERROR("~map_file %s not loaded (%s); starting with an empty map.", map_file.c_str(), error.c_str());
+    }
 
     tf_buffer_.reset(new tf2_ros::Buffer);
     tf_listener_.reset(new tf2_ros::TransformListener(*tf_buffer_));
@@ -101,6 +122,7 @@ private:
     reset_srv_ = private_nh.advertiseService("reset", &PlaneDetectorNodelet::resetService, this);
     save_srv_ = private_nh.advertiseService("save_map", &PlaneDetectorNodelet::saveMapService, this);
     load_srv_ = private_nh.advertiseService("load_map", &PlaneDetectorNodelet::loadMapService, this);
+    if (!detector_->planes().empty()) publishMap();  // the ~map_file's planes, latched
 
     reconfigure_server_.reset(new dynamic_reconfigure::Server<HoughPlaneDetectorConfig>(config_mutex_, private_nh));
     {
@@ -383,6 +405,7 @@ private:
   DetectorParams params_;
   std::string world_frame_;
   bool latch_ = true;
+  std::string save_on_shutdown_;  // path the map is saved to when the nodelet is unloaded
   ros::Time last_stamp_;
   double last_ms_ = 0.0;
   int frames_processed_ = 0, frames_dropped_ = 0, frames_rejected_ = 0;

@@ -112,7 +112,7 @@ void fillSegmentedCloud(const std_msgs::Header& header, const CloudView& view, c
   sensor_msgs::PointCloud2Modifier modifier(out);
   modifier.setPointCloud2Fields(5, "x", 1, sensor_msgs::PointField::FLOAT32, "y", 1, sensor_msgs::PointField::FLOAT32,
                                 "z", 1, sensor_msgs::PointField::FLOAT32, "rgb", 1, sensor_msgs::PointField::FLOAT32,
-                                "label", 1, sensor_msgs::PointField::INT32);
+                                "label", 1, sensor_msgs::PointField::UINT32);
   out.height = view.height;
   out.width = view.width;
   modifier.resize(static_cast<size_t>(view.width) * view.height);
@@ -121,13 +121,14 @@ void fillSegmentedCloud(const std_msgs::Header& header, const CloudView& view, c
   out.row_step = out.point_step * out.width;
   out.is_dense = false;
   sensor_msgs::PointCloud2Iterator<float> x(out, "x"), rgb(out, "rgb");
-  sensor_msgs::PointCloud2Iterator<int32_t> label(out, "label");
+  // uint32 like PCL's PointXYZRGBL label, so pcl::fromROSMsg keeps it; no plane is kNoPlaneLabel.
+  sensor_msgs::PointCloud2Iterator<uint32_t> label(out, "label");
   for (int v = 0; v < view.height; ++v)
     for (int u = 0; u < view.width; ++u, ++x, ++rgb, ++label)
     {
       view.point(u, v, x[0], x[1], x[2]);
       const int id = labels[static_cast<size_t>(v) * view.width + u];
-      *label = id;
+      *label = id >= 0 ? static_cast<uint32_t>(id) : kNoPlaneLabel;
       uint8_t r = 128, g = 128, b = 128;  // grey: on no plane
       if (id >= 0)
       {

@@ -1,6 +1,8 @@
 // RViz markers and the segmented cloud for the plane map.
 #pragma once
 
+#include <cstdint>
+
 #include <vector>
 
 #include <Eigen/Core>
@@ -21,7 +23,9 @@ visualization_msgs::Marker deleteAllMarker(const std_msgs::Header& header);
 // normal (ARROW, "normals") and id label (TEXT_VIEW_FACING, "labels"); marker id = plane id.
 void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane,
                         const std::vector<Eigen::Vector3d>& hull, std::vector<visualization_msgs::Marker>& markers);
-// x y z of the frame plus rgb and label (plane id, -1 for none) per point.
+// Label of a point on no plane in the segmented cloud (uint32, as PCL's PointXYZRGBL).
+constexpr uint32_t kNoPlaneLabel = 0xFFFFFFFFu;
+// x y z of the frame plus rgb and label (uint32 plane id, kNoPlaneLabel for none) per point.
 void fillSegmentedCloud(const std_msgs::Header& header, const CloudView& view, const std::vector<int>& labels,
                         sensor_msgs::PointCloud2& out);
 
