@@ -171,6 +171,8 @@ int planesOnCurvedObjects(const PlaneDetector& detector, const CloudView& view,
   return count;
 }
 
+}  // namespace
+
 bool writeSegmentedPicture(const std::string& path, const PlaneDetector& detector, const CloudView& view, std::string* error)
 {
   std::vector<int> labels;
@@ -186,14 +188,17 @@ bool writeSegmentedPicture(const std::string& path, const PlaneDetector& detecto
       uint8_t c[3] = {90, 90, 90};
       if (labels[i] >= 0)
       {
-        const uint32_t h = static_cast<uint32_t>(labels[i]) * 2654435761u;
-        c[0] = 80 + (h >> 8) % 176, c[1] = 80 + (h >> 16) % 176, c[2] = 80 + (h >> 24) % 176;
+        // Saturated hues a golden angle apart, so no plane looks like the grey of "no plane".
+        const double hue = std::fmod(labels[i] * 0.618033988749895, 1.0) * 6.0;
+        const double x = 1.0 - std::abs(std::fmod(hue, 2.0) - 1.0);
+        const double rgb_hue[6][3] = {{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}};
+        const double* f = rgb_hue[static_cast<int>(hue) % 6];
+        for (int k = 0; k < 3; ++k) c[k] = static_cast<uint8_t>(60 + 195 * f[k]);
       }
       std::copy(c, c + 3, rgb.begin() + 3 * i);
     }
   return writePng(path, view.width, view.height, rgb, error);
 }
-}  // namespace
 
 bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool with_pcl,
                       const std::string& picture_dir, OsdResults& results, std::string* error)

@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "hough_plane_detector/core/cloud_view.h"
 #include "hough_plane_detector/core/detector_params.h"
+#include "hough_plane_detector/core/plane_detector.h"
 
 namespace hough_plane_detector
 {
@@ -41,6 +43,11 @@ struct OsdResults
   std::map<std::string, int> misses_by_reason;
   std::vector<std::string> pictures;     // segmented frames written (PNG paths)
 };
+
+// The last frame of `detector` as a PNG, each pixel in its plane's colour (grey: on no plane,
+// black: no return); `view` must be that frame.
+bool writeSegmentedPicture(const std::string& path, const PlaneDetector& detector, const CloudView& view,
+                           std::string* error);
 
 // Runs the data set in `dir` (annotations.json beside learn*.pcd). `with_pcl` adds the two PCL
 // methods; `picture_dir`, when not empty, receives a few segmented frames as PNG. Returns false
