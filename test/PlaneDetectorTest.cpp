@@ -486,7 +486,10 @@ TEST(PlaneDetector, NearlyLevelPlanesTakeTheFloorsNormalInsteadOfATiltedTwin)
               false_with, 100 * found_without, false_without);
 }
 
-TEST(PlaneDetector, CurvedClutterYieldsNoPlane)
+namespace
+{
+// A floor with pillars and balls of 0.12-0.5 m radius, and the camera's slow walk toward them.
+Scene curvedClutterScene()
 {
   Scene scene;
   scene.addRectangle({0, 0, 0}, kX, kY, 8.0, 8.0, "floor");
@@ -495,13 +498,23 @@ TEST(PlaneDetector, CurvedClutterYieldsNoPlane)
   scene.cylinders.push_back({{1.5, 0.3, 0.0}, 0.12, 1.0});
   scene.spheres.push_back({{1.6, -0.1, 1.3}, 0.3});
   scene.spheres.push_back({{3.2, -0.2, 0.5}, 0.5});
-  SceneRenderer renderer(scene);
+  return scene;
+}
+
+Eigen::Isometry3d curvedClutterPose(int frame)
+{
+  return lookAt({0.02 * frame, 0.05 * std::sin(0.3 * frame), 1.2}, {2.5, 0.0, 0.6});
+}
+}  // namespace
+
+TEST(PlaneDetector, CurvedClutterYieldsNoPlane)
+{
+  SceneRenderer renderer(curvedClutterScene());
   PlaneDetector detector{DetectorParams()};
   std::map<CandidateVerdict, int> refused;  // the curved surfaces' peaks, by the test that refused them
   for (int f = 0; f < 20; ++f)
   {
-    const Eigen::Isometry3d pose = lookAt({0.02 * f, 0.05 * std::sin(0.3 * f), 1.2}, {2.5, 0.0, 0.6});
-    feed(detector, renderer.render(pose, kinect(1.0), 200 + f), f);
+    feed(detector, renderer.render(curvedClutterPose(f), kinect(1.0), 200 + f), f);
     for (const auto& p : detector.planes())
       EXPECT_FALSE(matching({p}, kZ, 0.0, 0.02, 0.03).empty()) << "frame " << f << ": plane that is not the floor"
                                                                << describe({p});
@@ -655,22 +668,14 @@ TEST(PlaneDetector, RegionGrowingFindsBoxFacesTooSmallForAWindowsVote)
 // plane (a band through the sensor) as edge-on (kEdgeOn); the map holds the floor alone.
 TEST(PlaneDetector, RegionGrowingRefusesCurvedAndEdgeOnRegions)
 {
-  Scene scene;
-  scene.addRectangle({0, 0, 0}, kX, kY, 8.0, 8.0, "floor");
-  scene.cylinders.push_back({{2.0, -0.6, 0.0}, 0.25, 1.5});
-  scene.cylinders.push_back({{2.5, 0.7, 0.0}, 0.4, 2.0});
-  scene.cylinders.push_back({{1.5, 0.3, 0.0}, 0.12, 1.0});
-  scene.spheres.push_back({{1.6, -0.1, 1.3}, 0.3});
-  scene.spheres.push_back({{3.2, -0.2, 0.5}, 0.5});
-  SceneRenderer renderer(scene);
+  SceneRenderer renderer(curvedClutterScene());
   DetectorParams params;
   params.region_growing = 1;
   PlaneDetector detector(params);
   std::map<CandidateVerdict, int> refused;
   for (int f = 0; f < 20; ++f)
   {
-    const Eigen::Isometry3d pose = lookAt({0.02 * f, 0.05 * std::sin(0.3 * f), 1.2}, {2.5, 0.0, 0.6});
-    feed(detector, renderer.render(pose, kinect(1.0), 200 + f), f);
+    feed(detector, renderer.render(curvedClutterPose(f), kinect(1.0), 200 + f), f);
     for (const auto& p : detector.planes())
       EXPECT_FALSE(matching({p}, kZ, 0.0, 0.02, 0.03).empty()) << "frame " << f << ": plane that is not the floor"
                                                                << describe({p});

@@ -72,7 +72,8 @@ public:
   // 4-connected components, largest first.
   std::vector<std::vector<int>> seedComponents(const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
   // Grows `seed` (with a first plane guess) over neighbouring blocks not taken, refitting the
-  // plane after each sweep, until nothing more joins.
+  // plane after each sweep, until nothing more joins; then fits the plane to the region's
+  // interior and trims blocks beyond two sigmas of it (into `trimmed`).
   PlaneRegion grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
   // True when the block may join a region of plane (normal, d).
   bool accepts(int block, const Eigen::Vector3d& normal, double d) const;
