@@ -10,10 +10,12 @@ out="$root/build/fuzz"
 cmake -S "$root/fuzz" -B "$out" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE= > "$out.configure.log" 2>&1 \
   || { cat "$out.configure.log"; exit 1; }
 cmake --build "$out" -j2 > "$out.build.log" 2>&1 || { tail -30 "$out.build.log"; exit 1; }
-mkdir -p "$out/corpus_map" "$out/corpus_cloud"
+mkdir -p "$out/corpus_map" "$out/corpus_cloud" "$out/corpus_pcd_header"
 "$out/make_seed_map" "$out/corpus_map/seed.map" "$out/corpus_cloud/seed.cloud"
+printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n0 0 1\n0 0 1\n' \
+  > "$out/corpus_pcd_header/seed.pcd"
 status=0
-for target in fuzz_cloud_view fuzz_map_file; do
+for target in fuzz_cloud_view fuzz_map_file fuzz_pcd_header; do
   corpus="$out/corpus_${target#fuzz_}"
   corpus="${corpus/corpus_cloud_view/corpus_cloud}"
   corpus="${corpus/corpus_map_file/corpus_map}"

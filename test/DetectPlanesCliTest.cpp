@@ -227,4 +227,12 @@ TEST(DetectPlanesCli, RefusesFilesThatAreNotPcd)
   r = run(mismatch);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("differ in number"), std::string::npos) << r.output;
+
+  // Sizes whose product would overflow are refused, not multiplied.
+  const std::string huge = tempPath("huge.pcd");
+  std::ofstream(huge) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 9000000000000000000\nHEIGHT 3\n"
+                         "POINTS 5\nDATA ascii\n";
+  r = run(huge);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("does not match POINTS"), std::string::npos) << r.output;
 }

@@ -2,7 +2,6 @@
 // /tf and /tf_static, transformed into a world frame).
 #pragma once
 
-#include <istream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,9 +18,6 @@ namespace hough_plane_detector
 
 PointBufferLayout layoutOf(const pcl::PCLPointCloud2& cloud);
 
-// "" when the stream starts with a complete PCD header (every required key, sizes that agree),
-// otherwise what is wrong; reads at most 64 lines.
-std::string checkPcdHeader(std::istream& in);
 // Loads a PCD file whose header passed checkPcdHeader; false with `error` naming the file and
 // the problem.
 bool loadPcd(const std::string& path, pcl::PCLPointCloud2& cloud, std::string* error);
