@@ -209,30 +209,23 @@ TEST(DetectPlanesCli, JsonNumbersRoundTrip)
 // (PCL 1.13 crashed on one line of text).
 TEST(DetectPlanesCli, RefusesFilesThatAreNotPcd)
 {
-  const std::string text = tempPath("notes.pcd");
-  std::ofstream(text) << "remember to buy milk\n";
-  RunResult r = run(text);
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("not a PCD header"), std::string::npos) << r.output;
-
-  const std::string no_points = tempPath("nopoints.pcd");
-  std::ofstream(no_points) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 2\n"
-                              "DATA ascii\n0 0 1\n0 0 1\n0 0 1\n0 0 1\n";
-  r = run(no_points);
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("no POINTS"), std::string::npos) << r.output;
-
-  const std::string mismatch = tempPath("mismatch.pcd");
-  std::ofstream(mismatch) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 2\nPOINTS 4\nDATA ascii\n";
-  r = run(mismatch);
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("differ in number"), std::string::npos) << r.output;
-
-  // Sizes whose product would overflow are refused, not multiplied.
-  const std::string huge = tempPath("huge.pcd");
-  std::ofstream(huge) << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 9000000000000000000\nHEIGHT 3\n"
-                         "POINTS 5\nDATA ascii\n";
-  r = run(huge);
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_NE(r.output.find("does not match POINTS"), std::string::npos) << r.output;
+  // Each file's text and the words the refusal must contain.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"remember to buy milk\n", "not a PCD header"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 2\nDATA ascii\n"
+       "0 0 1\n0 0 1\n0 0 1\n0 0 1\n",
+       "no POINTS"},
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 2\nPOINTS 4\nDATA ascii\n", "differ in number"},
+      // Sizes whose product would overflow are refused, not multiplied.
+      {"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 9000000000000000000\nHEIGHT 3\nPOINTS 5\nDATA ascii\n",
+       "does not match POINTS"},
+  };
+  for (size_t i = 0; i < cases.size(); ++i)
+  {
+    const std::string path = tempPath("notpcd" + std::to_string(i) + ".pcd");
+    std::ofstream(path) << cases[i].first;
+    const RunResult r = run(path);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(cases[i].second), std::string::npos) << r.output;
+  }
 }
