@@ -229,6 +229,27 @@ bool BlockRegionGrower::fit(const std::vector<int>& blocks, Eigen::Vector3d& nor
   return true;
 }
 
+std::vector<int> interiorBlocks(const std::vector<int>& blocks, int bx_count, int by_count)
+{
+  std::vector<char> member(static_cast<size_t>(bx_count) * by_count, 0);
+  for (int b : blocks) member[b] = 1;
+  std::vector<int> interior;
+  for (int b : blocks)
+  {
+    int inside = 0;
+    forEachNeighbour(b, bx_count, by_count, [&](int nb) { inside += member[nb]; });
+    if (inside == 4) interior.push_back(b);
+  }
+  return interior;
+}
+
+bool BlockRegionGrower::fitInterior(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const
+{
+  const std::vector<int> interior = interiorBlocks(blocks, grid_.blocksX(), grid_.blocksY());
+  if (interior.size() >= kMinInteriorBlocks && fit(interior, normal, d)) return true;
+  return fit(blocks, normal, d);
+}
+
 std::vector<std::vector<int>> BlockRegionGrower::seedComponents(const Eigen::Vector3d& normal, double d,
                                                                 const std::vector<char>& taken)
 {
@@ -284,29 +305,10 @@ PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::V
     fit(region.blocks, region.normal, region.d);
     if (!grew) break;
   }
-  // The plane of the region's interior (blocks whose four neighbours are in it): blocks on its
-  // rim may straddle the fold to a neighbouring surface (a stair's nosing) and tilt the fit.
-  {
-    ++generation_;
-    for (int b : region.blocks) mark_[b] = generation_;
-    std::vector<int> interior;
-    for (int b : region.blocks)
-    {
-      int inside = 0;
-      forEachNeighbour(b, bx_count, by_count, [&](int nb) { inside += mark_[nb] == generation_; });
-      if (inside == 4) interior.push_back(b);
-    }
-    constexpr size_t kMinInteriorBlocks = 6;
-    Eigen::Vector3d n = region.normal;
-    double interior_d = region.d;
-    if (interior.size() >= kMinInteriorBlocks && fit(interior, n, interior_d))
-    {
-      region.normal = n;
-      region.d = interior_d;
-    }
-  }
-  // Blocks that joined at the plane's first guess but lie beyond two sigmas of the final fit
-  // (edges where a riser meets a tread) would tilt it: the fit is made again without them.
+  // Blocks that joined at the plane's first guess but lie beyond two sigmas of the interior's
+  // plane (edges where a riser meets a tread) would tilt it: the fit is made again without
+  // them, over all blocks kept (the curvature tests need the rim a tangent plane would miss).
+  fitInterior(region.blocks, region.normal, region.d);
   for (int pass = 0; pass < 2; ++pass)
   {
     std::vector<int> inliers, outliers;

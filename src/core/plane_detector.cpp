@@ -34,6 +34,7 @@ constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a pl
 constexpr double kMaxParallelCentroidSigma = 0.3;  // parallel search: of support_distance
 constexpr double kMinParallelGrazingSine = 0.1;    // parallel search: rays at least ~6 deg to the plane
 constexpr double kMinSnapInlierShare = 0.8;        // snapping: points that must lie on the parallel plane
+constexpr double kMaxSnapChi2Increase = 9.21;      // snapping: chi^2 with 2 dof, p = 0.01
 
 // Angle between two planes' normals regardless of their sign.
 double unsignedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
@@ -651,7 +652,7 @@ void PlaneDetector::growRegions(const std::vector<Peak>& peaks, std::vector<Peak
       verdict = CandidateVerdict::kTooFewPoints;
     else if ((moments = keepFlatComponents(region.blocks, params_.merge_angle, 1)).count < std::max(3, params_.min_support))
       verdict = CandidateVerdict::kCurvedPatches;
-    else if (!grower.fit(region.blocks, region.normal, region.d))
+    else if (!grower.fit(region.blocks, region.normal, region.d))  // of the flat components kept
       verdict = CandidateVerdict::kTooFewPoints;
     else if (grower.seenEdgeOn(region.blocks, region.normal))
       verdict = CandidateVerdict::kEdgeOn;
@@ -764,9 +765,43 @@ bool PlaneDetector::snapToKnownDirection(Eigen::Vector3d& normal, double& d, con
   if (inlier_points < kMinSnapInlierShare * total) return false;
   const double d_cam = weighted_d / weight_sum;
   if (centroidChi2(n_cam, d_cam, inliers) > kMaxMeanCentroidChi2) return false;
+  // The known normal must also explain the inliers about as well as their own best plane: a
+  // likelihood-ratio test (2 degrees of freedom, the normal's), else a box face a few degrees
+  // off an older box's would take its direction. Judged on the interior: rim blocks straddling
+  // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
+  std::vector<int> interior = interiorBlocks(inliers, normals_.blocksX(), normals_.blocksY());
+  if (interior.size() < kMinInteriorBlocks) interior = inliers;
+  if (snapChi2Increase(n_cam, interior) > kMaxSnapChi2Increase) return false;
   normal = known;
   d = d_cam - known.dot(camera_to_world_.translation());
   return true;
+}
+
+double PlaneDetector::snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+{
+  // Centroids weighted by their inverse variance: the smallest eigenvalue of their scatter
+  // times the total weight is the chi^2 of the best free plane; the fixed normal's best plane
+  // has the weighted variance of the offsets along it.
+  const int bx_count = normals_.blocksX();
+  PointMoments sum;
+  double weight_sum = 0.0, offset_sum = 0.0, offset_squares = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = block_info_[b];
+    const double weight = 1.0 / (info.centroid_variance + kCentroidFloor);
+    PointMoments m = centroidMoments(normals_.block(b % bx_count, b / bx_count));
+    m.scale(weight / m.count);
+    sum.add(m);
+    const double offset = n_cam.dot(info.centroid);
+    weight_sum += weight;
+    offset_sum += weight * offset;
+    offset_squares += weight * offset * offset;
+  }
+  if (weight_sum <= 0.0) return 0.0;
+  const double fixed_chi2 = offset_squares - offset_sum * offset_sum / weight_sum;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(sum.covariance());
+  return fixed_chi2 - std::max(0.0, solver.eigenvalues()(0)) * sum.count;
 }
 
 double PlaneDetector::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const

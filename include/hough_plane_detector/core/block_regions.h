@@ -45,6 +45,12 @@ void forEachNeighbour(int b, int bx_count, int by_count, Visit&& visit)
   if (by + 1 < by_count) visit(b + bx_count);
 }
 
+// Blocks on a region's rim may straddle the fold to a neighbouring surface (a stair's nosing,
+// a shelf board's back edge against the wall); its interior, the blocks whose four neighbours
+// are in it too, cannot. Fits use the interior when it has at least this many blocks.
+constexpr size_t kMinInteriorBlocks = 6;
+std::vector<int> interiorBlocks(const std::vector<int>& blocks, int bx_count, int by_count);
+
 // A block's points all moved to their centroid: fits over many blocks then see the surface
 // without the depth noise inside blocks, which would tilt their normals toward the rays.
 PointMoments centroidMoments(const PointMoments& block);
@@ -72,8 +78,8 @@ public:
   // 4-connected components, largest first.
   std::vector<std::vector<int>> seedComponents(const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
   // Grows `seed` (with a first plane guess) over neighbouring blocks not taken, refitting the
-  // plane after each sweep, until nothing more joins; then fits the plane to the region's
-  // interior and trims blocks beyond two sigmas of it (into `trimmed`).
+  // plane after each sweep, until nothing more joins; then trims blocks beyond two sigmas of
+  // the interior's plane (into `trimmed`) and fits the plane to what is left.
   PlaneRegion grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
   // True when the block may join a region of plane (normal, d).
   bool accepts(int block, const Eigen::Vector3d& normal, double d) const;
@@ -88,6 +94,9 @@ public:
   bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // Weighted least-squares plane of the blocks' centroids; false when they fix no plane.
   bool fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
+  // The same over the blocks' interior (those whose four neighbours are among them) when it
+  // is large enough, else over all of them.
+  bool fitInterior(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
 
 private:
   const NormalEstimator& grid_;

@@ -191,6 +191,9 @@ private:
   // parallel plane within their noise. True if it did.
   bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
                             const std::vector<Peak>& supported) const;
+  // How much more chi^2 the block centroids have about their best plane of the camera-frame
+  // normal than about their own best plane (both with the centroids' noise).
+  double snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
   // Mean chi^2 of the block centroids about a camera-frame plane of fixed normal.
   double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
   // Moments of the blocks, each weighted by the inverse variance of the sensor at its depth.
