@@ -392,7 +392,7 @@ struct TourResult
 // kWarmupFrames; PCL's methods on exactly those frames when with_pcl. Misses of ours are
 // tallied by cause into `causes`.
 TourResult runTour(const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, uint32_t seed, int stride,
-                   bool with_pcl, std::map<std::string, int>& causes, int region_growing = 0)
+                   bool with_pcl, std::map<std::string, int>& causes, int region_growing = DetectorParams().region_growing)
 {
   SceneRenderer renderer(scene);
   const auto rendered = renderSequence(renderer, poses, kRoomNoise, seed);
@@ -590,9 +590,9 @@ void otherToursExperiment(Report& report)
                      all_ours.detectionPercent(), all_ours.falsePerFrame()));
 }
 
-// Table 3's tours with region_growing 1 (ours only): what the per-frame stage chosen for the
-// real frames does to the rendered scenes.
-void regionGrowingTours(Report& report)
+// Table 3's tours with the paper's per-frame stage (region_growing 0, ours only) beside the
+// default block regions.
+void windowsTours(Report& report)
 {
   const int frames = report.quick ? 16 : 60;
   const int stride = report.quick ? 8 : 3;
@@ -602,28 +602,30 @@ void regionGrowingTours(Report& report)
                       "|---|---|---|---|---|---|---|\n";
   for (const auto& named : tableThreeScenes())
   {
-    std::fprintf(stderr, "  region_growing: %s\n", named.name);
+    std::fprintf(stderr, "  windows' fit: %s\n", named.name);
     const TourResult w = runTour(named.scene, roomTour(frames), 11000, stride, false, causes, 0);
     const TourResult r = runTour(named.scene, roomTour(frames), 11000, stride, false, causes, 1);
-    table += fmt("| %s ", named.name) + accuracyRow("windows (default)", w.ours);
-    table += fmt("| %s ", named.name) + accuracyRow("region_growing 1", r.ours);
+    table += fmt("| %s ", named.name) + accuracyRow("block regions (default)", r.ours);
+    table += fmt("| %s ", named.name) + accuracyRow("windows (region_growing 0)", w.ours);
     windows.merge(w.ours);
     regions.merge(r.ours);
   }
-  table += "| **all scenes** " + accuracyRow("windows (default)", windows);
-  table += "| **all scenes** " + accuracyRow("region_growing 1", regions);
-  report.md << "## Table 3's tours with region_growing\n\n"
-            << "The same tours and scoring as Table 3, ours only, with the per-frame stage that grows block "
-               "regions (the one the osd-learn section measures) beside the default windows' fit.\n\n"
+  table += "| **all scenes** " + accuracyRow("block regions (default)", regions);
+  table += "| **all scenes** " + accuracyRow("windows (region_growing 0)", windows);
+  report.md << "## Table 3's tours: block regions against the paper's windows\n\n"
+            << "The same tours and scoring as Table 3, ours only: the default per-frame stage (block regions "
+               "grown from the Hough peaks) beside the paper's (each peak takes the windows that agree with it, "
+               "`region_growing 0`).\n\n"
             << table << '\n';
-  report.verdict(regions.falsePerFrame() < 0.05 && regions.detectionPercent() >= windows.detectionPercent(),
-                 fmt("Table 3's tours with region_growing 1: %.1f %% detected (windows %.1f %%), %.3f false planes per "
-                     "frame < 0.05",
-                     regions.detectionPercent(), windows.detectionPercent(), regions.falsePerFrame()));
+  report.verdict(regions.detectionPercent() >= windows.detectionPercent() && regions.falsePerFrame() <= windows.falsePerFrame(),
+                 fmt("Table 3's tours: block regions detect %.1f %% (windows %.1f %%) with %.3f false planes per frame "
+                     "(windows %.3f)",
+                     regions.detectionPercent(), windows.detectionPercent(), regions.falsePerFrame(),
+                     windows.falsePerFrame()));
 }
 
 // Procedural rooms (sim/random_scene.h): the held-out seeds decide, the tuning seeds are shown
-// beside them. Ours only (windows and region_growing), every 3rd frame from frame 3.
+// beside them. Ours only (defaults, ablations, the paper's windows), every 3rd frame from frame 3.
 void randomSceneExperiment(Report& report)
 {
   const int frames = report.quick ? 12 : 30;
@@ -636,10 +638,10 @@ void randomSceneExperiment(Report& report)
     std::function<void(DetectorParams&)> change;
   };
   const std::vector<Variant> variants = {
-      {"**windows (default)**", [](DetectorParams&) {}},
-      {"windows, no parallel search", [](DetectorParams& p) { p.parallel_support = 0; }},
-      {"windows, no snap", [](DetectorParams& p) { p.snap_angle = 0.0; }},
-      {"region_growing 1", [](DetectorParams& p) { p.region_growing = 1; }},
+      {"**defaults (block regions)**", [](DetectorParams&) {}},
+      {"no parallel search", [](DetectorParams& p) { p.parallel_support = 0; }},
+      {"no snap", [](DetectorParams& p) { p.snap_angle = 0.0; }},
+      {"windows (region_growing 0)", [](DetectorParams& p) { p.region_growing = 0; }},
   };
   std::vector<MethodStats> held_out(variants.size()), tuning(variants.size());
   std::string rows;
@@ -698,7 +700,7 @@ void randomSceneExperiment(Report& report)
                    "adds. Targets on the held-out seeds (C = 0.5-2 here, not C = 1 alone): >= 95 %% detected, <= "
                    "0.05 false planes per frame, E_angle <= 0.01 rad, E_d <= 1 cm.\n\n",
                    frames, kWarmupFrames)
-            << table << "\n| held-out seed | room | windows detected | false / frame | region_growing detected | "
+            << table << "\n| held-out seed | room | defaults detected | false / frame | windows detected | "
                         "false / frame |\n|---|---|---|---|---|---|\n"
             << rows << '\n';
   const MethodStats& h = held_out.front();
@@ -715,10 +717,9 @@ bool realFrames(Report& report, const std::vector<std::string>& paths)
   std::vector<double> ours_ms, ransac_ms, organized_ms;
   size_t ransac_planes = 0, organized_planes = 0;
   std::string pictures, found;
-  DetectorParams regions;
-  regions.region_growing = 1;
-  regions.strong_support = 2000;
-  // Each frame alone (one frame is a complete answer), with the defaults and with region_growing.
+  DetectorParams first_sight;
+  first_sight.strong_support = 2000;
+  // Each frame alone (one frame is a complete answer), with the defaults and with first sight at 2,000 points.
   for (size_t i = 0; i < paths.size(); ++i)
   {
     pcl::PCLPointCloud2 blob;
@@ -733,17 +734,17 @@ bool realFrames(Report& report, const std::vector<std::string>& paths)
     const std::string file = paths[i].substr(paths[i].find_last_of('/') + 1);
     for (int mode = 0; mode < 2; ++mode)
     {
-      PlaneDetector detector(mode ? regions : DetectorParams());
+      PlaneDetector detector(mode ? first_sight : DetectorParams());
       if (!detector.processFrame(view, Eigen::Isometry3d::Identity(), 0.0, &error))
       {
         std::fprintf(stderr, "%s: %s\n", paths[i].c_str(), error.c_str());
         return false;
       }
       if (mode == 0) ours_ms.push_back(detector.lastTimings().total_ms);
-      const std::string picture = fmt("kinect_real_%zu_%s.png", i, mode ? "regions" : "defaults");
+      const std::string picture = fmt("kinect_real_%zu_%s.png", i, mode ? "first_sight" : "defaults");
       if (writeSegmentedPicture(report.out_dir + "/results/" + picture, detector, view, &error))
         pictures += "![" + picture + "](results/" + picture + ") ";
-      found += fmt("- %s, %s: %zu planes:", file.c_str(), mode ? "region_growing 1, strong_support 2000" : "defaults",
+      found += fmt("- %s, %s: %zu planes:", file.c_str(), mode ? "strong_support 2000" : "defaults",
                    detector.planes().size());
       for (const DetectedPlane& p : detector.planes())
         found += fmt(" n (%.2f, %.2f, %.2f) d %.3f m, %d points;", p.normal.x(), p.normal.y(), p.normal.z(), p.d, p.support);
@@ -766,27 +767,27 @@ bool realFrames(Report& report, const std::vector<std::string>& paths)
             << fmt("| Hough 1024 (defaults) | %.2f | see below |\n", median(ours_ms))
             << fmt("| PCL RANSAC (0.05 m, 500 it) | %.2f | %zu |\n", median(ransac_ms), ransac_planes)
             << fmt("| PCL OMPS | %.2f | %zu |\n\n", median(organized_ms), organized_planes) << found << '\n'
-            << "Segmented (plane colours; grey: on no plane; black: no return), defaults then region_growing:\n\n"
+            << "Segmented (plane colours; grey: on no plane; black: no return), defaults then strong_support 2000:\n\n"
             << pictures << "\n\n";
   return true;
 }
 
-// ../shared/data/osd-learn: real frames with annotated planes, the defaults and region_growing.
+// ../shared/data/osd-learn: real frames with annotated planes, the defaults and first sight at
+// 2,000 points.
 bool osdLearnFrames(Report& report, const std::string& dir)
 {
   if (dir.empty()) return true;
-  DetectorParams regions;
-  regions.region_growing = 1;
-  regions.strong_support = 2000;
+  DetectorParams first_sight;
+  first_sight.strong_support = 2000;
   OsdResults defaults, grown;
   std::string error;
   if (!evaluateOsdLearn(dir, DetectorParams(), true, "", defaults, &error) ||
-      !evaluateOsdLearn(dir, regions, false, report.out_dir + "/results", grown, &error))
+      !evaluateOsdLearn(dir, first_sight, false, report.out_dir + "/results", grown, &error))
   {
     std::fprintf(stderr, "osd-learn: %s\n", error.c_str());
     return false;
   }
-  for (OsdMethodResult& m : grown.methods) m.method += ", region_growing 1, strong_support 2000";
+  for (OsdMethodResult& m : grown.methods) m.method += ", strong_support 2000";
   OsdResults table = defaults;
   table.methods.insert(table.methods.begin() + 2, grown.methods.begin(), grown.methods.end());
   table.misses = grown.misses;
@@ -798,13 +799,15 @@ bool osdLearnFrames(Report& report, const std::string& dir)
                    "and mugs). Scored as its README says: a detection matches an entry within 0.06 rad and 3 cm; a "
                    "second detection of one entry is a duplicate; an unmatched detection is not necessarily false "
                    "(small faces and the background are not annotated). PCL with 1,500 points as minimum. These frames "
-                   "are not held out: region_growing's noise terms were chosen while looking at them. The misses "
-                   "listed and the pictures (plane colours; grey: on no plane) are region_growing's. Pixel labels "
+                   "are not held out: the block regions' noise terms were chosen while looking at them. With the "
+                   "defaults a plane enters the map at first sight only with 16,000 points (x sensor_noise^2); "
+                   "strong_support 2000 lets a box face in from one frame. The misses listed and the pictures (plane "
+                   "colours; grey: on no plane) are strong_support 2000's. Pixel labels "
                    "(pictures, planes on cans) come from the map's support step, which still assigns 32 px windows: "
                    "small faces are often left grey and the count of planes on cans is a lower bound.\n\n")
             << osdLearnMarkdown(table, "results/");
   report.verdict(best.foundPercent() >= 90.0 && best.duplicates == 0 && best.curved_planes == 0,
-                 fmt("osd-learn, one frame (region_growing 1): %.1f %% of the annotated planes >= 90 %%, %d duplicates, "
+                 fmt("osd-learn, one frame (strong_support 2000): %.1f %% of the annotated planes >= 90 %%, %d duplicates, "
                      "%d planes on cans and mugs (target 0)",
                      best.foundPercent(), best.duplicates, best.curved_planes));
   return true;
@@ -844,8 +847,8 @@ int main(int argc, char** argv)
   if (!realFrames(report, pcds)) return 1;
   std::fprintf(stderr, "Procedural rooms: held-out seeds\n");
   randomSceneExperiment(report);
-  std::fprintf(stderr, "Table 3's tours with region_growing\n");
-  regionGrowingTours(report);
+  std::fprintf(stderr, "Table 3's tours with the windows' fit\n");
+  windowsTours(report);
   std::fprintf(stderr, "osd-learn: real frames with annotated planes\n");
   if (!osdLearnFrames(report, osd_dir)) return 1;
 

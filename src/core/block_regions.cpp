@@ -131,7 +131,7 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
   for (int b : blocks)
   {
     const BlockInfo& i = info_[b];
-    const double sigma = i.region_residual / 3.0, w = 1.0 / (sigma * sigma);
+    const double w = 1.0 / (i.centroid_variance + kMinBlockSigma * kMinBlockSigma / 64.0);
     const double x = (i.centroid - mean).dot(u), y = (i.centroid - mean).dot(v);
     const double r = normal.dot(i.centroid) + d;
     Eigen::Matrix<double, 6, 1> a;

@@ -100,11 +100,11 @@ struct DetectorParams
   // most of its points lie on the parallel plane within their noise (a far stair tread leaning
   // on its edges); 0 never.
   double snap_angle = 0.1;
-  // Per-frame planes: 0 = each Hough peak takes the windows that agree with it (the paper);
-  // 1 = each peak seeds regions of 8 x 8 pixel blocks grown while they lie on the refitted plane
-  // within the sensor's noise, then the flat blocks left seed regions of their own (small faces
-  // that raise no peak). First sight still follows strong_support (2000 suits table tops).
-  int region_growing = 0;
+  // Per-frame planes: 1 = each Hough peak seeds regions of 8 x 8 pixel blocks grown while they
+  // lie on the refitted plane within the sensor's noise, then the flat blocks left seed regions
+  // of their own (small faces that raise no peak); 0 = each peak takes the windows that agree
+  // with it (the paper). First sight still follows strong_support (2000 suits table tops).
+  int region_growing = 1;
 
   // Returns an empty string when the combination is valid, otherwise what is wrong.
   std::string validate() const;
