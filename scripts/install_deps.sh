@@ -8,14 +8,14 @@ packages=(
   libsensor-msgs-dev libgeometry-msgs-dev libgtest-dev ros-std-msgs ros-geometry-msgs ros-sensor-msgs ros-tf2-msgs
   python3-rostest python3-rosbag python3-catkin-pkg
   libnodelet-dev libnodeletlib-dev libnodeletlib-tools libtf2-ros-dev libtf2-eigen-dev libtf2-sensor-msgs-dev
-  libvisualization-msgs-dev libstd-srvs-dev libshape-msgs-dev libdynamic-reconfigure-config-init-mutex-dev
+  libvisualization-msgs-dev libstd-srvs-dev libshape-msgs-dev libpcl-msgs-dev ros-pcl-msgs libdynamic-reconfigure-config-init-mutex-dev
   python3-dynamic-reconfigure libdiagnostic-updater-dev libmessage-filters-dev libpcl-conversions-dev libpng-dev nlohmann-json3-dev libopenni2-dev clang libclang-rt-14-dev
   ros-std-srvs ros-shape-msgs ros-visualization-msgs ros-diagnostic-msgs ros-message-runtime
   python3-roslaunch python3-rosmaster python3-rospy rosout tf2-tools rosbash
   # What a ROS user reaches for first: rostopic echo/hz, rosservice call, rosnode, rosparam, and
   # the Python bindings of every message this package's messages and topics use.
   python3-rostopic python3-rosservice python3-rosnode python3-rosparam python3-std-msgs
-  python3-geometry-msgs python3-shape-msgs python3-sensor-msgs python3-visualization-msgs
+  python3-geometry-msgs python3-shape-msgs python3-pcl-msgs python3-sensor-msgs python3-visualization-msgs
   python3-std-srvs python3-diagnostic-msgs
 )
 # Extra packages a target needs beyond these (make evaluate: gnuplot-nox).

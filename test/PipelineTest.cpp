@@ -9,11 +9,17 @@
 #include <mutex>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "hough_plane_detector/ClusterPointIndices.h"
 #include "hough_plane_detector/LoadMap.h"
+#include "hough_plane_detector/ModelCoefficientsArray.h"
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/SaveMap.h"
 #include "hough_plane_detector/core/scene_renderer.h"
@@ -158,6 +164,80 @@ TEST(Pipeline, PlanesAndMarkersAreLatched)
   ASSERT_TRUE(received.wait_for(lock, std::chrono::seconds(30), [&] { return latching.size() == 2; }));
   EXPECT_EQ(latching["planes"], "1");
   EXPECT_EQ(latching["markers"], "1");
+}
+
+// What other ROS tools read: the segmented cloud through PCL's PointXYZRGBL (uint32 label),
+// ~coefficients as pcl_msgs/ModelCoefficients and ~inliers as pcl_msgs/PointIndices, one per
+// map plane in the order of ~planes; for one frame the inliers are exactly the points the
+// segmented cloud labels with that plane.
+TEST(Pipeline, PclOutputsMatchThePlanesAndTheSegmentedCloud)
+{
+  ros::NodeHandle nh;
+  std::mutex mutex;
+  std::condition_variable received;
+  std::map<double, sensor_msgs::PointCloud2::ConstPtr> segmented;
+  std::map<double, ClusterPointIndices::ConstPtr> inliers;
+  std::map<double, ModelCoefficientsArray::ConstPtr> coefficients;
+  std::map<double, PlaneArray::ConstPtr> planes;
+  auto keep = [&](auto& into, const auto& message) {
+    std::lock_guard<std::mutex> lock(mutex);
+    into[message->header.stamp.toSec()] = message;
+    received.notify_all();
+  };
+  const ros::Subscriber s1 = nh.subscribe<sensor_msgs::PointCloud2>(
+      kNode + "/segmented_cloud", 5, [&](const sensor_msgs::PointCloud2::ConstPtr& m) { keep(segmented, m); });
+  const ros::Subscriber s2 = nh.subscribe<ClusterPointIndices>(
+      kNode + "/inliers", 5, [&](const ClusterPointIndices::ConstPtr& m) { keep(inliers, m); });
+  const ros::Subscriber s3 = nh.subscribe<ModelCoefficientsArray>(
+      kNode + "/coefficients", 5, [&](const ModelCoefficientsArray::ConstPtr& m) { keep(coefficients, m); });
+  const ros::Subscriber s4 =
+      nh.subscribe<PlaneArray>(kNode + "/planes", 5, [&](const PlaneArray::ConstPtr& m) { keep(planes, m); });
+  // One frame whose four messages all arrived and whose map has planes.
+  double stamp = -1.0;
+  std::unique_lock<std::mutex> lock(mutex);
+  ASSERT_TRUE(received.wait_for(lock, std::chrono::seconds(90), [&] {
+    for (const auto& entry : segmented)
+      if (inliers.count(entry.first) && coefficients.count(entry.first) && planes.count(entry.first) &&
+          planes[entry.first]->planes.size() >= 3)
+      {
+        stamp = entry.first;
+        return true;
+      }
+    return false;
+  }));
+  const PlaneArray& map = *planes[stamp];
+  const ModelCoefficientsArray& model = *coefficients[stamp];
+  const ClusterPointIndices& indices = *inliers[stamp];
+  pcl::PointCloud<pcl::PointXYZRGBL> cloud;
+  pcl::fromROSMsg(*segmented[stamp], cloud);
+  lock.unlock();
+  ASSERT_EQ(cloud.width, 640u);
+  ASSERT_EQ(cloud.height, 480u);
+  ASSERT_EQ(model.coefficients.size(), map.planes.size());
+  ASSERT_EQ(indices.cluster_indices.size(), map.planes.size());
+  EXPECT_EQ(model.header.frame_id, map.header.frame_id);
+  EXPECT_EQ(indices.header.frame_id, segmented[stamp]->header.frame_id);
+  std::map<uint32_t, size_t> labelled;  // plane id -> points the PCL cloud labels with it
+  for (const pcl::PointXYZRGBL& p : cloud.points) ++labelled[p.label];
+  size_t on_planes = 0;
+  for (size_t i = 0; i < map.planes.size(); ++i)
+  {
+    const Plane& plane = map.planes[i];
+    ASSERT_EQ(model.coefficients[i].values.size(), 4u);
+    EXPECT_NEAR(model.coefficients[i].values[0], plane.normal.x, 1e-6);
+    EXPECT_NEAR(model.coefficients[i].values[1], plane.normal.y, 1e-6);
+    EXPECT_NEAR(model.coefficients[i].values[2], plane.normal.z, 1e-6);
+    EXPECT_NEAR(model.coefficients[i].values[3], plane.d, 1e-5);
+    const std::vector<int32_t>& on_plane = indices.cluster_indices[i].indices;
+    EXPECT_EQ(on_plane.size(), labelled[static_cast<uint32_t>(plane.id)]) << "plane " << plane.id;
+    for (int32_t index : on_plane)
+    {
+      ASSERT_LT(static_cast<size_t>(index), cloud.points.size());
+      ASSERT_EQ(cloud.points[index].label, static_cast<uint32_t>(plane.id));
+    }
+    on_planes += on_plane.size();
+  }
+  EXPECT_GT(on_planes, 100000u) << "a room's floor and walls fill most of a VGA frame";
 }
 
 TEST(Pipeline, ResetClearsPlanesAndMarkers)

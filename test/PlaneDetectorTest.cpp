@@ -11,6 +11,7 @@
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/core/plane_metrics.h"
 #include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/core/sensor_model.h"
 
 using namespace hough_plane_detector;
 
@@ -589,6 +590,30 @@ TEST(PlaneDetector, CurvedClutterYieldsNoPlane)
   int refused_total = 0;
   for (const auto& [verdict, count] : refused) refused_total += count;
   EXPECT_GT(refused_total, 0) << "the pillars and balls raised no Hough peak that a planarity test refused";
+}
+
+// The detector reads the focal length of the sensor from each cloud (its disparity steps,
+// hence every noise test, follow from it): a wide 385 px lens, as a D435's, is measured as such,
+// and a cloud that cannot tell (nothing valid) keeps the last estimate.
+TEST(PlaneDetector, ReadsTheFocalLengthOfItsClouds)
+{
+  CameraIntrinsics wide;
+  wide.fx = wide.fy = 385.0;
+  const SceneRenderer renderer(makeOfficeRoom(), wide);
+  PlaneDetector detector{DetectorParams()};
+  EXPECT_EQ(detector.noiseModel().focal(), nominalFocalLength(kKinectV1));
+  const auto poses = roomTour(6);
+  for (size_t f = 0; f < poses.size(); ++f) feed(detector, renderer.render(poses[f], kinect(1.0), 60 + f), 0.1 * f);
+  EXPECT_NEAR(detector.noiseModel().focal(), 385.0, 1.0);
+  EXPECT_NEAR(detector.noiseModel().quantizationStep(4.0), 16.0 / (385.0 * 0.075 * 8.0), 1e-4);
+  EXPECT_EQ(matching(detector.planes(), kZ, 0.0, 0.01, 0.02).size(), 1u) << "the floor" << describe(detector.planes());
+  std::vector<float> nothing(640 * 480 * 3, std::numeric_limits<float>::quiet_NaN());
+  RenderedFrame empty;
+  empty.width = 640;
+  empty.height = 480;
+  empty.xyz = nothing;
+  feed(detector, empty, 1.0);
+  EXPECT_NEAR(detector.noiseModel().focal(), 385.0, 1.0);
 }
 
 TEST(PlaneDetector, BadInputIsRefusedAndLeavesTheMapUntouched)

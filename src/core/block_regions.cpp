@@ -48,12 +48,13 @@ PointMoments weightedCentroidMoments(const NormalEstimator& grid, const std::vec
   return sum;
 }
 
-void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, std::vector<BlockInfo>& info)
+void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
+                    std::vector<BlockInfo>& info)
 {
   const int bx_count = grid.blocksX(), count = grid.blocksX() * grid.blocksY();
   info.assign(count, BlockInfo());
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  const bool noise_aware = params.sensor_noise > 0.0;
+  const bool noise_aware = noise.enabled();
   for (int b = 0; b < count; ++b)
   {
     const PointMoments& block = grid.block(b % bx_count, b / bx_count);
@@ -62,8 +63,8 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, s
     if (!i.valid) continue;
     i.centroid = block.mean();
     i.covariance = block.covariance();
-    const double sigma = sensorDepthSigma(i.centroid.z(), params.sensor_noise);
-    const double step = noise_aware ? quantizationStep(i.centroid.z()) : 0.0;
+    const double sigma = noise.sigma(i.centroid.z());
+    const double step = noise.quantizationStep(i.centroid.z());
     // Quantization moves a block as a whole, so it does not average out over the block.
     i.centroid_variance = sigma * sigma / block.count + step * step / 12.0;
     // Around a fitted plane a centroid may stray by its noise and 1 cm of sensor warp.

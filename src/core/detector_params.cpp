@@ -61,6 +61,8 @@ std::string DetectorParams::validate() const
   if (max_window_scale != 1 && max_window_scale != 2 && max_window_scale != 4)
     err << "max_window_scale must be 1, 2 or 4, got " << max_window_scale << "; ";
   if (!(sensor_noise >= 0.0 && sensor_noise <= 10.0)) err << "sensor_noise must be in [0, 10], got " << sensor_noise << "; ";
+  if (sensor_model < 0 || sensor_model > 3)
+    err << "sensor_model must be 0 (kinect_v1), 1 (xtion), 2 (realsense_d400) or 3 (tof), got " << sensor_model << "; ";
   if (!(support_distance > 0.0)) err << "support_distance must be > 0, got " << support_distance << "; ";
   if (!(support_angle > 0.0 && support_angle < 1.5)) err << "support_angle must be in (0, 1.5) rad, got " << support_angle << "; ";
   if (parallel_support < 0) err << "parallel_support must be >= 0, got " << parallel_support << "; ";

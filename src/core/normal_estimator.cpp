@@ -66,23 +66,6 @@ int blockSize(int /*window: a multiple of the stride*/, int stride)
   return 1;
 }
 
-double quantizationStep(double depth)
-{
-  // Kinect disparity: f = 580 px, baseline 0.075 m, 1/8 px steps.
-  return depth * depth / (580.0 * 0.075 * 8.0);
-}
-
-double sensorDepthSigma(double depth, double noise_coefficient)
-{
-  if (noise_coefficient <= 0.0) return 0.0;
-  const double z_mm = depth * 1000.0;
-  const double eq11 = std::max(0.0, 2.6610e-6 * z_mm * z_mm * noise_coefficient * noise_coefficient -
-                                        1.0787e-3 * z_mm * noise_coefficient + 2.7011) / 1000.0;
-  // A uniform step has standard deviation step / sqrt(12).
-  const double quantization_step = quantizationStep(depth);
-  return std::sqrt(eq11 * eq11 + quantization_step * quantization_step / 12.0);
-}
-
 namespace
 {
 // Squared thickness over squared width (smallest over middle eigenvalue) above which a window's
@@ -237,7 +220,7 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
         // C = 1): the noise covariance along the ray is taken out, no more of it than the
         // window's own thickness shows (so a window less noisy than the model is not over-corrected).
         const Eigen::Vector3d centre = m.mean();
-        const double sigma = sensorDepthSigma(centre.z(), config.sensor_noise);
+        const double sigma = config.noise.sigma(centre.z());
         const Eigen::Vector3d ray = centre / centre.z();  // a depth error e moves a point by e * ray
         const Eigen::Matrix3d covariance = m.covariance();
         solver.computeDirect(covariance);

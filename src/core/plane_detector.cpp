@@ -142,7 +142,12 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
   normal_config.stride = params_.normal_stride;
   normal_config.min_valid_fraction = params_.min_valid_fraction;
   normal_config.max_curvature = params_.max_curvature;
-  normal_config.sensor_noise = params_.sensor_noise;
+  // The sensor's projection from the cloud itself (its focal length sets the disparity steps);
+  // the last good estimate, or the sensor's nominal one, when this cloud cannot tell.
+  const double focal = estimateFocalLength(cloud);
+  if (focal > 0.0) focal_length_ = focal;
+  noise_ = DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_);
+  normal_config.noise = noise_;
   normal_config.max_window_scale = params_.max_window_scale;
   normals_.compute(cloud, camera_to_world, normal_config, samples_);
   stats_.windows_valid = normals_.validWindows();
@@ -415,7 +420,7 @@ bool PlaneDetector::isPlanarFit(const PointMoments& moments, const std::vector<i
     const double count = normals_.block(b % bx_count, b / bx_count).count;
     // The block's own scatter along the plane normal: noise if it lies on the plane.
     const double own_variance = std::max(0.0, normal.dot(info.covariance * normal));
-    const double step = params_.sensor_noise > 0.0 ? quantizationStep(info.centroid.z()) : 0.0;
+    const double step = noise_.quantizationStep(info.centroid.z());
     const double distance = normal.dot(info.centroid - mean);
     chi2 += distance * distance / (own_variance / count + step * step / 12.0 + kCentroidFloor);
   }
@@ -517,7 +522,7 @@ PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks, double 
 
 void PlaneDetector::findLocalPeaks()
 {
-  describeBlocks(normals_, params_, block_info_);
+  describeBlocks(normals_, params_, noise_, block_info_);
   // A peak above the threshold has voted cells next to it blurred to well over half of it
   // (the kernel falls to 0.6 one cell away); climbing from the rest only finds weak peaks.
   std::vector<Eigen::Vector3i> seeds;

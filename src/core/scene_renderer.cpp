@@ -1,5 +1,7 @@
 #include "hough_plane_detector/core/scene_renderer.h"
 
+#include "hough_plane_detector/core/sensor_model.h"
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -66,9 +68,7 @@ CloudView RenderedFrame::view() const
 
 double kinectNoiseSigma(double depth, double coefficient)
 {
-  const double z = depth * 1000.0;  // eq. 11 works in millimetres
-  const double sigma_mm = 2.6610e-6 * z * z * coefficient * coefficient - 1.0787e-3 * z * coefficient + 2.7011;
-  return std::max(0.0, sigma_mm) / 1000.0;
+  return structuredLightSigma(depth, coefficient);
 }
 
 SceneRenderer::SceneRenderer(const Scene& scene, const CameraIntrinsics& intrinsics)

@@ -119,6 +119,8 @@ private:
     planes_pub_ = private_nh.advertise<PlaneArray>("planes", 2, latch_);
     markers_pub_ = private_nh.advertise<visualization_msgs::MarkerArray>("markers", 2, latch_);
     segmented_pub_ = private_nh.advertise<sensor_msgs::PointCloud2>("segmented_cloud", 2);
+    coefficients_pub_ = private_nh.advertise<ModelCoefficientsArray>("coefficients", 2, latch_);
+    inliers_pub_ = private_nh.advertise<ClusterPointIndices>("inliers", 2);
     reset_srv_ = private_nh.advertiseService("reset", &PlaneDetectorNodelet::resetService, this);
     save_srv_ = private_nh.advertiseService("save_map", &PlaneDetectorNodelet::saveMapService, this);
     load_srv_ = private_nh.advertiseService("load_map", &PlaneDetectorNodelet::loadMapService, this);
@@ -252,7 +254,7 @@ private:
     last_ms_ = detector_->lastTimings().total_ms;
     last_stamp_ = cloud->header.stamp;
     publishMap();
-    if (segmented_pub_.getNumSubscribers() > 0) publishSegmented(*cloud, view);
+    if (segmented_pub_.getNumSubscribers() > 0 || inliers_pub_.getNumSubscribers() > 0) publishLabels(*cloud, view);
   }
 
   // Caller holds map_mutex_.
@@ -292,15 +294,28 @@ private:
     }
     planes_pub_.publish(planes);
     markers_pub_.publish(markers);
+    ModelCoefficientsArray::Ptr coefficients(new ModelCoefficientsArray);
+    fillModelCoefficients(header, detector_->planes(), *coefficients);
+    coefficients_pub_.publish(coefficients);
   }
 
-  void publishSegmented(const sensor_msgs::PointCloud2& cloud, const CloudView& view)
+  // The frame's points by plane: the segmented cloud and the inliers (each only when subscribed).
+  void publishLabels(const sensor_msgs::PointCloud2& cloud, const CloudView& view)
   {
     std::vector<int> labels;
     detector_->labelPixels(view, labels);
-    sensor_msgs::PointCloud2::Ptr out(new sensor_msgs::PointCloud2);
-    fillSegmentedCloud(cloud.header, view, labels, *out);
-    segmented_pub_.publish(out);
+    if (segmented_pub_.getNumSubscribers() > 0)
+    {
+      sensor_msgs::PointCloud2::Ptr out(new sensor_msgs::PointCloud2);
+      fillSegmentedCloud(cloud.header, view, labels, *out);
+      segmented_pub_.publish(out);
+    }
+    if (inliers_pub_.getNumSubscribers() > 0)
+    {
+      ClusterPointIndices::Ptr inliers(new ClusterPointIndices);
+      fillClusterIndices(cloud.header, detector_->planes(), labels, *inliers);
+      inliers_pub_.publish(inliers);
+    }
   }
 
   void reconfigure(HoughPlaneDetectorConfig& config, uint32_t /*level*/)
@@ -423,7 +438,7 @@ private:
   std::unique_ptr<ros::AsyncSpinner> cloud_spinner_;
   std::unique_ptr<message_filters::Subscriber<sensor_msgs::PointCloud2>> subscriber_;
   std::unique_ptr<tf2_ros::MessageFilter<sensor_msgs::PointCloud2>> tf_filter_;
-  ros::Publisher planes_pub_, markers_pub_, segmented_pub_;
+  ros::Publisher planes_pub_, markers_pub_, segmented_pub_, coefficients_pub_, inliers_pub_;
   ros::ServiceServer reset_srv_, save_srv_, load_srv_;
   boost::recursive_mutex config_mutex_;  // dynamic_reconfigure's own; the map has map_mutex_
   std::unique_ptr<dynamic_reconfigure::Server<HoughPlaneDetectorConfig>> reconfigure_server_;

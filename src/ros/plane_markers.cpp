@@ -1,5 +1,7 @@
 #include "hough_plane_detector/ros/plane_markers.h"
 
+#include <unordered_map>
+
 #include <cmath>
 #include <cstring>
 
@@ -140,6 +142,40 @@ void fillSegmentedCloud(const std_msgs::Header& header, const CloudView& view, c
       const uint32_t packed = (static_cast<uint32_t>(r) << 16) | (static_cast<uint32_t>(g) << 8) | b;
       std::memcpy(&*rgb, &packed, sizeof(float));
     }
+}
+
+void fillModelCoefficients(const std_msgs::Header& header, const std::vector<DetectedPlane>& planes,
+                           ModelCoefficientsArray& out)
+{
+  out.header = header;
+  out.coefficients.resize(planes.size());
+  for (size_t i = 0; i < planes.size(); ++i)
+  {
+    const DetectedPlane& p = planes[i];
+    out.coefficients[i].header = header;
+    out.coefficients[i].values = {static_cast<float>(p.normal.x()), static_cast<float>(p.normal.y()),
+                                  static_cast<float>(p.normal.z()), static_cast<float>(p.d)};
+  }
+}
+
+void fillClusterIndices(const std_msgs::Header& header, const std::vector<DetectedPlane>& planes,
+                        const std::vector<int>& labels, ClusterPointIndices& out)
+{
+  out.header = header;
+  out.cluster_indices.resize(planes.size());
+  std::unordered_map<int, size_t> slot;  // plane id -> position in `planes`
+  for (size_t i = 0; i < planes.size(); ++i)
+  {
+    slot[planes[i].id] = i;
+    out.cluster_indices[i].header = header;
+    out.cluster_indices[i].indices.clear();
+  }
+  for (size_t pixel = 0; pixel < labels.size(); ++pixel)
+  {
+    if (labels[pixel] < 0) continue;
+    const auto it = slot.find(labels[pixel]);
+    if (it != slot.end()) out.cluster_indices[it->second].indices.push_back(static_cast<int32_t>(pixel));
+  }
 }
 
 }  // namespace hough_plane_detector

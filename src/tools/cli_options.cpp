@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "hough_plane_detector/core/sensor_model.h"
+
 namespace hough_plane_detector
 {
 
@@ -52,6 +54,15 @@ bool setDetectorParam(DetectorParams& params, const std::string& name, const std
   {
     if (name != entry.name) continue;
     std::istringstream in(value);
+    if (name == "sensor_model")  // by name as well as by number
+    {
+      if (!parseSensorModel(value, &params.sensor_model))
+      {
+        if (error) *error = "parameter sensor_model needs kinect_v1, xtion, realsense_d400 or tof (or 0-3), got '" + value + "'";
+        return false;
+      }
+      return true;
+    }
     if (entry.int_member)
     {
       int v;

@@ -32,7 +32,8 @@ struct BlockInfo
 };
 
 // Fills `info` (row-major over the estimator's block grid) from the estimator's last frame.
-void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, std::vector<BlockInfo>& info);
+void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
+                    std::vector<BlockInfo>& info);
 
 // Calls visit(neighbour) for each 4-neighbour of block b inside a bx_count x by_count grid.
 template <class Visit>

@@ -28,6 +28,7 @@
   X(double, max_curvature)             \
   X(int, max_window_scale)             \
   X(double, sensor_noise)              \
+  X(int, sensor_model)                 \
   X(double, support_distance)          \
   X(double, support_angle)             \
   X(int, parallel_support)             \
@@ -86,9 +87,13 @@ struct DetectorParams
   // A window whose noise is as thick as half its width (far from a Kinect) is measured again
   // over 2x, then 4x, as wide a window around it, up to this factor: 1 (never), 2 or 4.
   int max_window_scale = 4;
-  // C_noc of eq. 11 assumed for the sensor: windows as rough as its noise still count as planar;
-  // 0 leaves only the curvature test.
+  // C_noc of eq. 11 assumed for the sensor (for sensor models other than the structured-light
+  // ones, a scale on their published noise curve): windows as rough as its noise still count as
+  // planar; 0 leaves only the curvature test.
   double sensor_noise = 1.0;
+  // Depth noise curve (core/sensor_model.h): 0 kinect_v1, 1 xtion, 2 realsense_d400, 3 tof.
+  // The focal length it needs comes from each cloud itself.
+  int sensor_model = 0;
 
   // A window supports a plane when its centroid is this close (m) and its normal this close (rad).
   double support_distance = 0.05;

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "hough_plane_detector/core/cloud_view.h"
+#include "hough_plane_detector/core/sensor_model.h"
 
 namespace hough_plane_detector
 {
@@ -45,8 +46,8 @@ struct NormalEstimatorConfig
   int stride = 8;
   double min_valid_fraction = 0.6;
   double max_curvature = 0.02;
-  // C_noc of the Kinect model (eq. 11) assumed for the sensor; 0 turns the noise-aware test off.
-  double sensor_noise = 1.0;
+  // The sensor's depth noise; a disabled model turns the noise-aware test off.
+  DepthNoiseModel noise;
   // Windows whose noise is as thick as half their width are measured again over 2x, then 4x,
   // as wide a window around them, up to this factor (1: never).
   int max_window_scale = 4;
@@ -54,10 +55,6 @@ struct NormalEstimatorConfig
 
 // Edge of the pixel blocks that carry point moments for a window and stride (<= 8 pixels).
 int blockSize(int window, int stride);
-// Depth step of a Kinect's 1/8-pixel disparity at depth z.
-double quantizationStep(double depth);
-// Expected depth noise (eq. 11 plus 1/8-pixel disparity quantization) of a Kinect at depth z.
-double sensorDepthSigma(double depth, double noise_coefficient);
 
 class NormalEstimator
 {

@@ -97,6 +97,9 @@ public:
   const std::vector<DetectedPlane>& planes() const { return planes_; }
   const StageTimings& lastTimings() const { return timings_; }
   const FrameStats& lastStats() const { return stats_; }
+  // The depth noise model of the last frame (sensor_model, sensor_noise, focal length read
+  // from the cloud).
+  const DepthNoiseModel& noiseModel() const { return noise_; }
   // Every local peak of the last frame that was tested as a plane, strongest first.
   const std::vector<PlaneCandidate>& lastCandidates() const { return candidates_; }
   MemoryReport memory() const;
@@ -236,6 +239,8 @@ private:
   int next_id_ = 0;
   StageTimings timings_;
   FrameStats stats_;
+  double focal_length_ = 0.0;  // px at 640 wide, from the clouds (0: the sensor's nominal one)
+  DepthNoiseModel noise_;      // the sensor's, for the last frame
 };
 
 }  // namespace hough_plane_detector

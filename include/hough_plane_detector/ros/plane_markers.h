@@ -1,4 +1,4 @@
-// RViz markers and the segmented cloud for the plane map.
+// RViz markers, the segmented cloud and the pcl_msgs outputs for the plane map.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +10,8 @@
 #include <std_msgs/ColorRGBA.h>
 #include <visualization_msgs/Marker.h>
 
+#include "hough_plane_detector/ClusterPointIndices.h"
+#include "hough_plane_detector/ModelCoefficientsArray.h"
 #include "hough_plane_detector/core/plane_detector.h"
 
 namespace hough_plane_detector
@@ -28,5 +30,12 @@ constexpr uint32_t kNoPlaneLabel = 0xFFFFFFFFu;
 // x y z of the frame plus rgb and label (uint32 plane id, kNoPlaneLabel for none) per point.
 void fillSegmentedCloud(const std_msgs::Header& header, const CloudView& view, const std::vector<int>& labels,
                         sensor_msgs::PointCloud2& out);
+// Each plane's [a, b, c, d] in the order of `planes`.
+void fillModelCoefficients(const std_msgs::Header& header, const std::vector<DetectedPlane>& planes,
+                           ModelCoefficientsArray& out);
+// Each plane's pixel indices (labels: the plane id of every pixel, -1 for none), in the order of
+// `planes`; a plane with no point in the frame gets an empty list.
+void fillClusterIndices(const std_msgs::Header& header, const std::vector<DetectedPlane>& planes,
+                        const std::vector<int>& labels, ClusterPointIndices& out);
 
 }  // namespace hough_plane_detector
