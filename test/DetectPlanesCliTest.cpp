@@ -122,6 +122,12 @@ TEST(DetectPlanesCli, FailsClearlyOnBadInput)
   r = run("--bag " + bag + " --topic /camera/depth/points --normal_window 12");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("normal_stride"), std::string::npos) << r.output;
+  // The sensor model by name; a name it does not know lists the ones it does.
+  r = run("--bag " + bag + " --topic /camera/depth/points --sensor_model kinect2");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("realsense_d400"), std::string::npos) << r.output;
+  r = run("--bag " + bag + " --topic /camera/depth/points --sensor_model tof");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
 }
 
 TEST(DetectPlanesCli, ReadsPcdFilesAsAStillCamera)
