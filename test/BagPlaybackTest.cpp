@@ -1,8 +1,6 @@
 // rosbag play --clock into the running nodelet gives the planes detect_planes finds offline.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <cstdio>
 #include <mutex>
 
@@ -18,16 +16,6 @@ namespace
 {
 bool always(int) { return true; }
 
-std::string runCommand(const std::string& command, int* exit_code)
-{
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  std::string output;
-  char buffer[4096];
-  while (pipe && fgets(buffer, sizeof(buffer), pipe)) output += buffer;
-  const int status = pipe ? pclose(pipe) : -1;
-  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return output;
-}
 }  // namespace
 
 TEST(BagPlayback, NodeletOnAPlayedBagMatchesTheOfflineTool)

@@ -2,6 +2,9 @@
 // parsing of detect_planes' JSON lines.
 #pragma once
 
+#include <sys/wait.h>
+
+#include <cstdio>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -104,6 +107,18 @@ inline void writeBag(const std::string& path, int frames, bool (*tf_for_frame)(i
     bag.write("/tf", ros::Time(stamp), tf);
   }
   bag.close();
+}
+
+// Runs a shell command; its stdout and stderr, and its exit code (-1 when it did not exit).
+inline std::string runCommand(const std::string& command, int* exit_code)
+{
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  std::string output;
+  char buffer[4096];
+  while (pipe && fgets(buffer, sizeof(buffer), pipe)) output += buffer;
+  const int status = pipe ? pclose(pipe) : -1;
+  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return output;
 }
 
 struct JsonPlane

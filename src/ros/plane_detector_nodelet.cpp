@@ -78,6 +78,7 @@ private:
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& private_nh = getPrivateNodeHandle();
     private_nh.param<std::string>("world_frame", world_frame_, "odom");
+    world_frame_ = tfFrame(world_frame_);
     private_nh.param("latch", latch_, true);  // a map server: late subscribers get the map
     int queue_size;
     private_nh.param("queue_size", queue_size, 2);
@@ -158,9 +159,15 @@ private:
                  subscriber_->getTopic().c_str(), world_frame_.c_str(), params_.resolution, std::max(1, concurrency_level));
   }
 
+  // tf2 frame ids have no leading '/'; tf1-era recordings (the TUM RGB-D bags) still send them.
+  static std::string tfFrame(const std::string& frame)
+  {
+    return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
+  }
+
   bool frameUnknown(const std::string& frame) const
   {
-    return !frame.empty() && frame != world_frame_ && !tf_buffer_->_frameExists(frame);
+    return !frame.empty() && tfFrame(frame) != world_frame_ && !tf_buffer_->_frameExists(tfFrame(frame));
   }
 
   void checkFrameKnown(const sensor_msgs::PointCloud2ConstPtr& cloud)
@@ -222,7 +229,7 @@ private:
     try
     {
       camera_to_world = tf2::transformToEigen(
-          tf_buffer_->lookupTransform(world_frame_, cloud->header.frame_id, cloud->header.stamp));
+          tf_buffer_->lookupTransform(world_frame_, tfFrame(cloud->header.frame_id), cloud->header.stamp));
     }
     catch (const tf2::TransformException& e)
     {
