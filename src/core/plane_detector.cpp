@@ -91,6 +91,7 @@ void PlaneDetector::reset()
 {
   chunks_evicted_total_ = 0;
   extents_.clear();
+  beliefs_.clear();
   frame_count_ = 0;
   global_.clear();
   local_.clear();
@@ -144,8 +145,12 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
   normal_config.max_curvature = params_.max_curvature;
   // The sensor's projection from the cloud itself (its focal length sets the disparity steps);
   // the last good estimate, or the sensor's nominal one, when this cloud cannot tell.
-  const double focal = estimateFocalLength(cloud);
-  if (focal > 0.0) focal_length_ = focal;
+  const PinholeIntrinsics intrinsics = estimateIntrinsics(cloud);
+  if (intrinsics.valid())
+  {
+    intrinsics_ = intrinsics;
+    focal_length_ = intrinsics.fx * 640.0 / cloud.width;
+  }
   noise_ = DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_);
   normal_config.noise = noise_;
   normal_config.max_window_scale = params_.max_window_scale;
@@ -165,6 +170,10 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
   t = Clock::now();
   findLocalPeaks();
   timings_.peaks_ms = msSince(t);
+
+  t = Clock::now();
+  if (params_.forgetting == kForgetByEvidence) checkEvidence(cloud);
+  timings_.evidence_ms = msSince(t);
 
   t = Clock::now();
   updateGlobal(camera_to_world.translation(), stamp);
@@ -994,8 +1003,14 @@ void PlaneDetector::addGaussian(SparseHoughSpace& space, const Eigen::Vector3d& 
 void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double stamp)
 {
   const float cap = static_cast<float>(params_.permanence_cap);
-  // Thinning (3.7) first, so a plane seen in this frame ends the frame at least 1 higher.
-  global_.thin(static_cast<float>(params_.thinning_rate), cap);
+  // Thinning (3.7) first, so a plane seen in this frame ends the frame at least 1 higher. By
+  // evidence, the cells of the map's planes are exempt (what is out of view keeps its state)
+  // and a plane the frames showed to be gone is cleared; the rest (votes no plane
+  // gathered) thins as in the paper.
+  if (params_.forgetting == kForgetByEvidence)
+    thinByEvidence(cap);
+  else
+    global_.thin(static_cast<float>(params_.thinning_rate), cap);
 
   // Algorithm 2: every local peak adds one Gaussian of maximum 1 to the global space. A plane
   // not yet in the map adds up to 2 when strongly supported, so that a big plane is reported the
@@ -1082,6 +1097,21 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
     planes_.push_back(plane);
   }
 
+  // Beliefs follow the ids: a new plane starts at PlaneBelief::kStart, a plane that left the
+  // map takes its belief with it.
+  if (params_.forgetting == kForgetByEvidence)
+  {
+    std::unordered_map<int, PlaneBelief> beliefs;
+    for (DetectedPlane& plane : planes_)
+    {
+      const auto it = beliefs_.find(plane.id);
+      const PlaneBelief& belief = beliefs[plane.id] = it != beliefs_.end() ? it->second : PlaneBelief();
+      plane.confirmations = belief.confirmations;
+      plane.contradictions = belief.contradictions;
+    }
+    beliefs_.swap(beliefs);
+  }
+
   // Support and labels of this frame: windows go to the plane they agree with, then their
   // blocks that lie on it count once.
   std::vector<Eigen::Vector3d> normals;
@@ -1119,7 +1149,7 @@ void PlaneDetector::updateGlobal(const Eigen::Vector3d& camera_position, double 
 
   // Extents: this frame's labelled blocks mark their cells; cells fade like the Hough space
   // (lazily, swept every 16 frames); extents of planes that left the map go with them.
-  const float fade = static_cast<float>(params_.thinning_rate);
+  const float fade = extentFade();
   std::unordered_map<int, PlaneExtent> extents;
   std::unordered_map<int, std::pair<PlaneExtent*, const DetectedPlane*>> by_id;
   for (const DetectedPlane& plane : planes_)
@@ -1182,10 +1212,70 @@ const PlaneExtent* PlaneDetector::extent(int id) const
   return it == extents_.end() ? nullptr : &it->second;
 }
 
+float PlaneDetector::extentFade() const
+{
+  // By evidence, where a plane was seen stays known until the plane goes.
+  return params_.forgetting == kForgetByEvidence ? 0.0f : static_cast<float>(params_.thinning_rate);
+}
+
+void PlaneDetector::checkEvidence(const CloudView& cloud)
+{
+  for (const DetectedPlane& plane : planes_)
+  {
+    const auto extent = extents_.find(plane.id);
+    if (extent == extents_.end()) continue;
+    const PlaneEvidence evidence = checkPlaneEvidence(extent->second, plane.normal, plane.d, cloud, camera_to_world_,
+                                                      intrinsics_, noise_, frame_count_, extentFade());
+    beliefs_[plane.id].update(evidence);
+  }
+}
+
+void PlaneDetector::thinByEvidence(float cap)
+{
+  // The cells around each map plane's peak (its blur and peak window, and the mirrored copy
+  // near the border): kept as they are, or cleared when the plane is gone.
+  const int r = blur_radius_ + params_.peak_window / 2 + 1;
+  std::vector<std::pair<Eigen::Vector3i, float>> kept;
+  auto forBox = [&](const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) {
+    std::vector<Eigen::Vector3d> centres{hough};
+    Eigen::Vector3d mirrored;
+    if (param_.mirror(hough, mirrored)) centres.push_back(mirrored);
+    for (const Eigen::Vector3d& centre : centres)
+    {
+      const Eigen::Vector3d c = param_.toCell(centre);
+      const int cx = static_cast<int>(std::lround(c.x())), cy = static_cast<int>(std::lround(c.y())),
+                cz = static_cast<int>(std::lround(c.z()));
+      for (int x = cx - r; x <= cx + r; ++x)
+        for (int y = cy - r; y <= cy + r; ++y)
+          for (int z = cz - r; z <= cz + r; ++z) f(x, y, z);
+    }
+  };
+  for (const DetectedPlane& plane : planes_)
+  {
+    const auto belief = beliefs_.find(plane.id);
+    if (belief != beliefs_.end() && belief->second.gone())
+      forBox(plane.hough, [&](int x, int y, int z) {
+        const float v = global_.value(x, y, z);
+        if (v > 0.0f) global_.add(x, y, z, -v);
+      });
+    else
+      forBox(plane.hough, [&](int x, int y, int z) {
+        const float v = global_.value(x, y, z);
+        if (v > 0.0f) kept.emplace_back(Eigen::Vector3i(x, y, z), v);
+      });
+  }
+  global_.thin(static_cast<float>(params_.thinning_rate), cap);
+  for (const auto& cell : kept)
+  {
+    const float now = global_.value(cell.first.x(), cell.first.y(), cell.first.z());
+    if (now < cell.second) global_.add(cell.first.x(), cell.first.y(), cell.first.z(), cell.second - now);
+  }
+}
+
 std::vector<Eigen::Vector3d> PlaneDetector::hull(const DetectedPlane& plane) const
 {
   const PlaneExtent* e = extent(plane.id);
-  return e ? e->hull(frame_count_, static_cast<float>(params_.thinning_rate)) : std::vector<Eigen::Vector3d>();
+  return e ? e->hull(frame_count_, extentFade()) : std::vector<Eigen::Vector3d>();
 }
 
 void PlaneDetector::labelPixels(const CloudView& cloud, std::vector<int>& labels) const

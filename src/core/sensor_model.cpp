@@ -82,11 +82,46 @@ double DepthNoiseModel::sigma(double depth) const
   return std::sqrt(random * random + step * step / 12.0);
 }
 
-double estimateFocalLength(const CloudView& cloud)
+namespace
 {
-  if (cloud.width < 8 || cloud.height < 2) return 0.0;
-  // x/z against u over a grid of pixels: slope 1/fx.
-  double n = 0, su = 0, sr = 0, suu = 0, sur = 0, srr = 0;
+// Least-squares line ratio = slope * pixel + intercept; false when it is no such line.
+struct LineFit
+{
+  double n = 0, sp = 0, sr = 0, spp = 0, spr = 0, srr = 0;
+  void add(double pixel, double ratio)
+  {
+    n += 1;
+    sp += pixel;
+    sr += ratio;
+    spp += pixel * pixel;
+    spr += pixel * ratio;
+    srr += ratio * ratio;
+  }
+  // focal = 1 / slope, centre = -intercept / slope.
+  bool solve(double* focal, double* centre) const
+  {
+    constexpr double kMinPoints = 100;
+    if (n < kMinPoints) return false;
+    const double var_p = spp / n - (sp / n) * (sp / n);
+    if (!(var_p > 0.0)) return false;
+    const double slope = (spr / n - (sp / n) * (sr / n)) / var_p;
+    if (!(slope > 0.0)) return false;
+    // Residual of the line in pixels: a cloud that is no pinhole projection has no focal length.
+    const double var_r = srr / n - (sr / n) * (sr / n);
+    const double residual_px = std::sqrt(std::max(0.0, var_r - slope * slope * var_p)) / slope;
+    if (!(residual_px < 1.0)) return false;
+    *focal = 1.0 / slope;
+    *centre = -(sr / n - slope * sp / n) / slope;
+    return true;
+  }
+};
+}  // namespace
+
+PinholeIntrinsics estimateIntrinsics(const CloudView& cloud)
+{
+  PinholeIntrinsics k;
+  if (cloud.width < 8 || cloud.height < 8) return k;
+  LineFit horizontal, vertical;
   const int step = std::max(1, cloud.width / 80);
   for (int v = 0; v < cloud.height; v += step)
     for (int u = 0; u < cloud.width; u += step)
@@ -94,26 +129,18 @@ double estimateFocalLength(const CloudView& cloud)
       float x, y, z;
       cloud.point(u, v, x, y, z);
       if (!std::isfinite(x + y + z) || z <= 0.0f) continue;
-      const double r = x / z;
-      n += 1;
-      su += u;
-      sr += r;
-      suu += static_cast<double>(u) * u;
-      sur += u * r;
-      srr += r * r;
+      horizontal.add(u, x / z);
+      vertical.add(v, y / z);
     }
-  constexpr double kMinPoints = 100;
-  if (n < kMinPoints) return 0.0;
-  const double var_u = suu / n - (su / n) * (su / n);
-  if (!(var_u > 0.0)) return 0.0;
-  const double slope = (sur / n - (su / n) * (sr / n)) / var_u;
-  if (!(slope > 0.0)) return 0.0;
-  const double fx = 1.0 / slope;
-  // Residual of the line in pixels: a cloud that is no pinhole projection has no focal length.
-  const double var_r = srr / n - (sr / n) * (sr / n);
-  const double residual_px = std::sqrt(std::max(0.0, var_r - slope * slope * var_u)) * fx;
-  if (!(residual_px < 1.0)) return 0.0;
-  return fx * kReferenceWidth / cloud.width;
+  PinholeIntrinsics fitted;
+  if (horizontal.solve(&fitted.fx, &fitted.cx) && vertical.solve(&fitted.fy, &fitted.cy)) k = fitted;
+  return k;
+}
+
+double estimateFocalLength(const CloudView& cloud)
+{
+  const PinholeIntrinsics k = estimateIntrinsics(cloud);
+  return k.valid() ? k.fx * kReferenceWidth / cloud.width : 0.0;
 }
 
 }  // namespace hough_plane_detector

@@ -33,10 +33,14 @@
   X(double, support_angle)             \
   X(int, parallel_support)             \
   X(double, snap_angle)                \
-  X(int, region_growing)
+  X(int, region_growing)               \
+  X(int, forgetting)
 
 namespace hough_plane_detector
 {
+
+constexpr int kForgetByThinning = 0;
+constexpr int kForgetByEvidence = 1;
 
 struct DetectorParams
 {
@@ -110,6 +114,10 @@ struct DetectorParams
   // of their own (small faces that raise no peak); 0 = each peak takes the windows that agree
   // with it (the paper). First sight still follows strong_support (2000 suits table tops).
   int region_growing = 1;
+  // How the map forgets: 0 = thinning (paper 3.7: every cell loses thinning_rate per frame),
+  // 1 = by evidence (a plane out of view keeps its state; one whose extent the frames show
+  // to be gone leaves within about ten frames; core/plane_evidence.h).
+  int forgetting = 0;
 
   // Returns an empty string when the combination is valid, otherwise what is wrong.
   std::string validate() const;

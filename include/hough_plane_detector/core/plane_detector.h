@@ -17,6 +17,7 @@
 #include "hough_plane_detector/core/detector_params.h"
 #include "hough_plane_detector/core/hough_parameterization.h"
 #include "hough_plane_detector/core/normal_estimator.h"
+#include "hough_plane_detector/core/plane_evidence.h"
 #include "hough_plane_detector/core/plane_extent.h"
 #include "hough_plane_detector/core/sparse_hough_space.h"
 
@@ -33,6 +34,8 @@ struct DetectedPlane
   double first_seen = 0.0;                            // stamp of the first frame it was reported
   double last_seen = 0.0;                             // stamp of the last frame with min_support points
   Eigen::Vector3d hough = Eigen::Vector3d::Zero();    // canonical (alpha, beta, d) of its peak
+  int64_t confirmations = 0;   // forgetting by evidence: frames whose depths confirmed it
+  int64_t contradictions = 0;  // ... and frames whose rays passed through where it should be
 };
 
 // What became of a local Hough peak of the last frame: why a plane in view was not detected.
@@ -62,6 +65,7 @@ struct StageTimings
 {
   double normals_ms = 0, voting_ms = 0, blur_ms = 0, peaks_ms = 0, global_ms = 0, total_ms = 0;
   double parallel_ms = 0;  // the parallel search, part of peaks_ms
+  double evidence_ms = 0;  // forgetting by evidence: the map's planes checked against the frame
 };
 
 struct MemoryReport
@@ -167,6 +171,12 @@ private:
   // support they become; blocks taken this way are claimed for the windows' labelling after it.
   void labelRegionBlocks();
   void updateGlobal(const Eigen::Vector3d& camera_position, double stamp);
+  // forgetting by evidence: each map plane's belief from this frame's depths over its extent.
+  void checkEvidence(const CloudView& cloud);
+  // forgetting by evidence: thinning that spares the map planes' cells and clears gone planes'.
+  void thinByEvidence(float cap);
+  // How fast extents fade per frame: with thinning as the Hough space does, by evidence never.
+  float extentFade() const;
   // Climbs from a cell to the local maximum under the (value, -index) total order.
   Eigen::Vector3i climb(const SparseHoughSpace& space, Eigen::Vector3i cell) const;
   bool isWindowMaximum(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const;
@@ -234,12 +244,14 @@ private:
   std::vector<PlaneCandidate> candidates_;
   std::vector<DetectedPlane> planes_;
   std::unordered_map<int, PlaneExtent> extents_;
+  std::unordered_map<int, PlaneBelief> beliefs_;  // forgetting by evidence, by plane id
   int64_t frame_count_ = 0;           // frames processed since the map began (extents fade by it)
   size_t chunks_evicted_total_ = 0;  // chunks freed by the max_chunks cap since the map began
   int next_id_ = 0;
   StageTimings timings_;
   FrameStats stats_;
   double focal_length_ = 0.0;  // px at 640 wide, from the clouds (0: the sensor's nominal one)
+  PinholeIntrinsics intrinsics_;  // of the last cloud that showed them
   DepthNoiseModel noise_;      // the sensor's, for the last frame
 };
 

@@ -52,6 +52,18 @@ double structuredLightSigma(double depth, double coefficient);
 // Nominal focal length in pixels of the sensor's 640-pixel-wide depth image.
 double nominalFocalLength(int model);
 
+// Pinhole projection of an organized cloud at its own resolution: u = fx x / z + cx.
+struct PinholeIntrinsics
+{
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  bool valid() const { return fx > 0.0 && fy > 0.0; }
+};
+
+// fx, cx from x/z against u and fy, cy from y/z against v (least-squares lines over a grid of
+// pixels); invalid when the cloud has too few valid points or is no pinhole projection (a fit
+// residual above a pixel).
+PinholeIntrinsics estimateIntrinsics(const CloudView& cloud);
+
 // The horizontal focal length of an organized cloud from its own points (x/z = (u - cx) / fx,
 // a least-squares line over a grid of pixels), for a 640-pixel-wide image (f * 640 / width:
 // the sensors measure disparity at that width whatever the cloud's); 0 when the cloud has too

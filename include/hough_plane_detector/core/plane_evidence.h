@@ -1,0 +1,55 @@
+// Forgetting by evidence (forgetting = 1): each frame, a map plane the camera could have seen
+// is checked against the frame's depths where its known extent projects. A depth on the plane
+// confirms it; a depth clearly behind it (the ray passed through where the plane should be)
+// contradicts it; no return, or something in front of it, is no evidence. The plane's
+// log-odds follow the evidence with clamping, as octomap's cells do; planes out of view keep
+// theirs.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Geometry>
+
+#include "hough_plane_detector/core/cloud_view.h"
+#include "hough_plane_detector/core/plane_extent.h"
+#include "hough_plane_detector/core/sensor_model.h"
+
+namespace hough_plane_detector
+{
+
+struct PlaneEvidence
+{
+  int confirmed = 0;     // extent cells whose pixel's depth lies on the plane
+  int contradicted = 0;  // extent cells whose pixel's depth lies clearly behind it
+};
+
+// Checks the live cells of `extent` (plane normal . p + d = 0, world frame) against the
+// organized cloud seen from camera_to_world with the given projection and noise.
+PlaneEvidence checkPlaneEvidence(const PlaneExtent& extent, const Eigen::Vector3d& normal, double d,
+                                 const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
+                                 const PinholeIntrinsics& intrinsics, const DepthNoiseModel& noise, int64_t frame,
+                                 float fade_per_frame);
+
+// Log-odds of a map plane, clamped as octomap's: a frame that mostly confirms a plane adds
+// kHit, one that mostly contradicts it adds kMiss (negative); below kRemoveBelow it is gone.
+struct PlaneBelief
+{
+  static constexpr double kHit = 0.4;
+  static constexpr double kMiss = -0.4;
+  static constexpr double kMax = 3.5;
+  static constexpr double kMin = -2.0;
+  static constexpr double kStart = 1.0;
+  static constexpr double kRemoveBelow = 0.0;
+  // Fewer cells than this (5 x 5 cm each: 0.05 m^2) in view say nothing either way.
+  static constexpr int kMinCells = 20;
+
+  double log_odds = kStart;
+  int64_t confirmations = 0;    // frames that confirmed it
+  int64_t contradictions = 0;   // frames that contradicted it
+
+  // Applies one frame's evidence; true when it changed the belief.
+  bool update(const PlaneEvidence& evidence);
+  bool gone() const { return log_odds < kRemoveBelow; }
+};
+
+}  // namespace hough_plane_detector

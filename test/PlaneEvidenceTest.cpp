@@ -1,0 +1,116 @@
+// Forgetting by evidence (forgetting = 1) against the paper's thinning: what is out of view
+// keeps its state, what the camera sees to be gone leaves.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <vector>
+
+#include "detector_test_helpers.h"
+#include "hough_plane_detector/core/plane_evidence.h"
+
+namespace
+{
+// A few noisy renderings of one pose, cycled: a still camera without rendering every frame.
+std::vector<RenderedFrame> stillCamera(const SceneRenderer& renderer, const Eigen::Isometry3d& pose, uint32_t seed)
+{
+  std::vector<RenderedFrame> frames;
+  for (uint32_t i = 0; i < 4; ++i) frames.push_back(renderer.render(pose, kinect(1.0), seed + i));
+  return frames;
+}
+
+DetectorParams forgettingBy(int forgetting)
+{
+  DetectorParams params;
+  params.forgetting = forgetting;
+  return params;
+}
+}  // namespace
+
+// A hall: the camera looks at the east wall for 15 frames, at the west wall for 1,000, then
+// back. By evidence the east wall, out of view all that time, is still in the map; thinning
+// loses it (paper 3.7: every cell loses thinning_rate per frame).
+TEST(PlaneEvidence, ALookedAwayWallStaysForAThousandFrames)
+{
+  Scene hall;
+  hall.addRectangle({0, 0, 0}, kX, kY, 6.0, 4.0, "floor");
+  hall.addRectangle({3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "east");
+  hall.addRectangle({-3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "west");
+  const SceneRenderer renderer(hall);
+  const auto east = stillCamera(renderer, lookAt({0, 0, 1.2}, {3.5, 0.3, 0.9}), 10);
+  const auto west = stillCamera(renderer, lookAt({0, 0, 1.2}, {-3.5, -0.3, 0.9}), 20);
+  for (int forgetting : {kForgetByEvidence, kForgetByThinning})
+  {
+    PlaneDetector detector(forgettingBy(forgetting));
+    int f = 0;
+    for (int i = 0; i < 15; ++i, ++f) feed(detector, east[f % 4], 0.033 * f);
+    ASSERT_EQ(matching(detector.planes(), kX, -3.5, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+    int away_until_lost = -1;
+    for (int i = 0; i < 1000; ++i, ++f)
+    {
+      feed(detector, west[f % 4], 0.033 * f);
+      if (away_until_lost < 0 && matching(detector.planes(), kX, -3.5, 0.01, 0.02).empty()) away_until_lost = i;
+    }
+    EXPECT_EQ(matching(detector.planes(), kX, 3.5, 0.01, 0.02).size(), 1u) << "the west wall" << describe(detector.planes());
+    if (forgetting == kForgetByEvidence)
+    {
+      EXPECT_EQ(away_until_lost, -1) << "the east wall left the map after " << away_until_lost << " frames away";
+      const DetectedPlane* wall = matching(detector.planes(), kX, -3.5, 0.01, 0.02).front();
+      EXPECT_GE(wall->confirmations, 10) << "its 15 frames in view confirmed it";
+      EXPECT_EQ(wall->contradictions, 0);
+    }
+    else
+    {
+      EXPECT_GE(away_until_lost, 0) << "thinning kept the east wall: the test no longer needs forgetting by evidence";
+    }
+    std::printf("look-away, forgetting %d: east wall lost after %d frames away (-1: kept)\n", forgetting, away_until_lost);
+    // Back: the east wall is (still, or again) there.
+    for (int i = 0; i < 5; ++i, ++f) feed(detector, east[f % 4], 0.033 * f);
+    EXPECT_EQ(matching(detector.planes(), kX, -3.5, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+  }
+}
+
+// A still camera watches a box on the floor before a wall; at frame 40 the box is taken away.
+// By evidence its top and front leave the map within 30 frames of seeing the floor and wall
+// where they were, while the floor and wall stay; with thinning they stay (permanent cells).
+TEST(PlaneEvidence, ATakenAwayBoxLeavesWithinThirtyFrames)
+{
+  Scene with_box, without_box;
+  for (Scene* scene : {&with_box, &without_box})
+  {
+    scene->addRectangle({2.0, 0, 0}, kX, kY, 3.0, 3.0, "floor");
+    scene->addRectangle({4.0, 0, 1.5}, kY, kZ, 3.0, 1.5, "wall");
+  }
+  with_box.addBox({2.0, 0.0, 0.25}, {0.25, 0.35, 0.25}, 0.0, "box");
+  const Eigen::Isometry3d pose = lookAt({0, 0, 1.2}, {2.5, 0.0, 0.3});
+  const auto before = stillCamera(SceneRenderer(with_box), pose, 30);
+  const auto after = stillCamera(SceneRenderer(without_box), pose, 40);
+  for (int forgetting : {kForgetByEvidence, kForgetByThinning})
+  {
+    PlaneDetector detector(forgettingBy(forgetting));
+    int f = 0;
+    for (; f < 40; ++f) feed(detector, before[f % 4], 0.033 * f);
+    ASSERT_EQ(matching(detector.planes(), kZ, -0.5, 0.02, 0.02).size(), 1u) << "box top" << describe(detector.planes());
+    ASSERT_EQ(matching(detector.planes(), kX, -1.75, 0.02, 0.02).size(), 1u) << "box front" << describe(detector.planes());
+    int top_gone = -1, front_gone = -1;
+    for (int i = 0; i < 60; ++i, ++f)
+    {
+      feed(detector, after[f % 4], 0.033 * f);
+      if (top_gone < 0 && matching(detector.planes(), kZ, -0.5, 0.02, 0.02).empty()) top_gone = i + 1;
+      if (front_gone < 0 && matching(detector.planes(), kX, -1.75, 0.02, 0.02).empty()) front_gone = i + 1;
+    }
+    std::printf("taken-away box, forgetting %d: top gone after %d frames, front after %d (-1: kept)\n", forgetting,
+                top_gone, front_gone);
+    EXPECT_EQ(matching(detector.planes(), kZ, 0.0, 0.01, 0.02).size(), 1u) << "floor" << describe(detector.planes());
+    EXPECT_EQ(matching(detector.planes(), kX, -4.0, 0.01, 0.02).size(), 1u) << "wall" << describe(detector.planes());
+    if (forgetting == kForgetByEvidence)
+    {
+      EXPECT_TRUE(top_gone > 0 && top_gone <= 30) << "box top left after " << top_gone << " frames";
+      EXPECT_TRUE(front_gone > 0 && front_gone <= 30) << "box front left after " << front_gone << " frames";
+    }
+    else
+    {
+      EXPECT_TRUE(top_gone < 0 || front_gone < 0) << "thinning removed both within 60 frames: the test no longer "
+                                                     "needs forgetting by evidence";
+    }
+  }
+}
