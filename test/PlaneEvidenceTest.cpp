@@ -69,6 +69,26 @@ TEST(PlaneEvidence, ALookedAwayWallStaysForAThousandFrames)
   }
 }
 
+// A plane seen in fewer than PlaneBelief::kEstablishedAfter frames is not yet kept out of view:
+// it fades as with thinning (a plane one glance suggested must not stay for good).
+TEST(PlaneEvidence, APlaneGlimpsedTwiceFadesOutOfView)
+{
+  Scene hall;
+  hall.addRectangle({0, 0, 0}, kX, kY, 6.0, 4.0, "floor");
+  hall.addRectangle({3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "east");
+  hall.addRectangle({-3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "west");
+  const SceneRenderer renderer(hall);
+  const auto east = stillCamera(renderer, lookAt({0, 0, 1.2}, {3.5, 0.3, 0.9}), 10);
+  const auto west = stillCamera(renderer, lookAt({0, 0, 1.2}, {-3.5, -0.3, 0.9}), 20);
+  PlaneDetector detector(forgettingBy(kForgetByEvidence));
+  int f = 0;
+  for (int i = 0; i < 2; ++i, ++f) feed(detector, east[f % 4], 0.033 * f);
+  ASSERT_EQ(matching(detector.planes(), kX, -3.5, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+  for (int i = 0; i < 300; ++i, ++f) feed(detector, west[f % 4], 0.033 * f);
+  EXPECT_TRUE(matching(detector.planes(), kX, -3.5, 0.01, 0.02).empty()) << describe(detector.planes());
+  EXPECT_EQ(matching(detector.planes(), kX, 3.5, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+}
+
 // A still camera watches a box on the floor before a wall; at frame 40 the box is taken away.
 // By evidence its top and front leave the map within 30 frames of seeing the floor and wall
 // where they were, while the floor and wall stay; with thinning they stay (permanent cells).

@@ -1232,8 +1232,9 @@ void PlaneDetector::checkEvidence(const CloudView& cloud)
 
 void PlaneDetector::thinByEvidence(float cap)
 {
-  // The cells around each map plane's peak (its blur and peak window, and the mirrored copy
-  // near the border): kept as they are, or cleared when the plane is gone.
+  // The cells around each established map plane's peak (its blur and peak window, and the
+  // mirrored copy near the border) are kept as they are, a gone plane's are cleared; a plane
+  // not yet established thins like everything else.
   const int r = blur_radius_ + params_.peak_window / 2 + 1;
   std::vector<std::pair<Eigen::Vector3i, float>> kept;
   auto forBox = [&](const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) {
@@ -1258,7 +1259,7 @@ void PlaneDetector::thinByEvidence(float cap)
         const float v = global_.value(x, y, z);
         if (v > 0.0f) global_.add(x, y, z, -v);
       });
-    else
+    else if (belief != beliefs_.end() && belief->second.established())
       forBox(plane.hough, [&](int x, int y, int z) {
         const float v = global_.value(x, y, z);
         if (v > 0.0f) kept.emplace_back(Eigen::Vector3i(x, y, z), v);

@@ -23,7 +23,9 @@ PlaneEvidence checkPlaneEvidence(const PlaneExtent& extent, const Eigen::Vector3
   const Eigen::Isometry3d world_to_camera = camera_to_world.inverse();
   const Eigen::Vector3d n_cam = world_to_camera.linear() * normal;
   const double d_cam = d - n_cam.dot(world_to_camera.translation());
-  extent.forEachLiveCell(frame, fade_per_frame, [&](const Eigen::Vector3d& centre) {
+  // A 10 cm lattice of the extent's 5 cm cells: as conclusive, a quarter of the work.
+  constexpr int kCellStride = 2;
+  extent.forEachLiveCell(frame, fade_per_frame, kCellStride, [&](const Eigen::Vector3d& centre) {
     const Eigen::Vector3d c = world_to_camera * centre;
     if (c.z() < kMinDepth) return;
     const int u = static_cast<int>(std::lround(k.fx * c.x() / c.z() + k.cx));

@@ -286,6 +286,8 @@ private:
       msg.d = p.d;
       msg.strength = p.strength;
       msg.support = static_cast<uint32_t>(p.support);
+      msg.confirmations = static_cast<uint32_t>(p.confirmations);
+      msg.contradictions = static_cast<uint32_t>(p.contradictions);
       msg.first_seen.fromSec(p.first_seen);
       msg.last_seen.fromSec(p.last_seen);
       for (const auto& v : hull)

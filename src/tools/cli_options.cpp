@@ -124,6 +124,8 @@ std::string frameToJson(int frame, double stamp, const std::string& frame_id, do
     plane["d"] = p.d;
     plane["strength"] = p.strength;
     plane["support"] = p.support;
+    plane["confirmations"] = p.confirmations;
+    plane["contradictions"] = p.contradictions;
     out["planes"].push_back(plane);
   }
   return out.dump();

@@ -19,11 +19,11 @@ namespace hough_plane_detector
 
 struct PlaneEvidence
 {
-  int confirmed = 0;     // extent cells whose pixel's depth lies on the plane
-  int contradicted = 0;  // extent cells whose pixel's depth lies clearly behind it
+  int confirmed = 0;     // checked extent cells whose pixel's depth lies on the plane
+  int contradicted = 0;  // checked extent cells whose pixel's depth lies clearly behind it
 };
 
-// Checks the live cells of `extent` (plane normal . p + d = 0, world frame) against the
+// Checks the live cells of `extent` on a 10 cm lattice (plane normal . p + d = 0, world frame) against the
 // organized cloud seen from camera_to_world with the given projection and noise.
 PlaneEvidence checkPlaneEvidence(const PlaneExtent& extent, const Eigen::Vector3d& normal, double d,
                                  const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
@@ -40,8 +40,12 @@ struct PlaneBelief
   static constexpr double kMin = -2.0;
   static constexpr double kStart = 1.0;
   static constexpr double kRemoveBelow = 0.0;
-  // Fewer cells than this (5 x 5 cm each: 0.05 m^2) in view say nothing either way.
-  static constexpr int kMinCells = 20;
+  // Fewer checked cells than this (on a 10 cm lattice: 0.05 m^2) in view say nothing either way.
+  static constexpr int kMinCells = 5;
+  // Frames that must confirm a plane before it keeps its state out of view (0.2 s at 30 Hz):
+  // until then it fades as in the paper, so a plane one view suggested (a pillar's tangent)
+  // does not stay for good once the camera turns away.
+  static constexpr int64_t kEstablishedAfter = 6;
 
   double log_odds = kStart;
   int64_t confirmations = 0;    // frames that confirmed it
@@ -50,6 +54,7 @@ struct PlaneBelief
   // Applies one frame's evidence; true when it changed the belief.
   bool update(const PlaneEvidence& evidence);
   bool gone() const { return log_odds < kRemoveBelow; }
+  bool established() const { return confirmations >= kEstablishedAfter; }
 };
 
 }  // namespace hough_plane_detector

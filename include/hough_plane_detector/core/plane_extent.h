@@ -45,15 +45,17 @@ public:
   // Convex hull of the live cells, counter-clockwise about the normal, in the world frame.
   std::vector<Eigen::Vector3d> hull(int64_t frame, float fade_per_frame) const;
   size_t cellCount() const { return cells_.size(); }
-  // Calls f(centre) with the world-frame centre of every live cell (unordered).
+  // Calls f(centre) with the world-frame centre of every live cell (unordered) whose
+  // coordinates are multiples of `every` (2: a 10 cm lattice).
   template <class F>
-  void forEachLiveCell(int64_t frame, float fade_per_frame, F f) const
+  void forEachLiveCell(int64_t frame, float fade_per_frame, int every, F f) const
   {
     if (!basis_) return;
     for (const auto& cell : cells_)
     {
-      if (weightAt(cell.second, frame, fade_per_frame) <= 0.0f) continue;
       const int32_t x = static_cast<int32_t>(cell.first >> 32), y = static_cast<int32_t>(cell.first & 0xffffffffu);
+      if (x % every != 0 || y % every != 0) continue;
+      if (weightAt(cell.second, frame, fade_per_frame) <= 0.0f) continue;
       f(basis_->lift(Eigen::Vector2d((x + 0.5) * kCellSize, (y + 0.5) * kCellSize)));
     }
   }
