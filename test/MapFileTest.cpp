@@ -194,3 +194,51 @@ TEST(PlaneExtent, HullCoversTheSeenPartOfTheFloorAndFades)
   }
   EXPECT_TRUE(extent.hull(10, 0.5f).empty()) << "faded out entirely";
 }
+
+// Two tables at one height are one plane of the map with two regions, each within its table;
+// one hull would span the gap between them.
+TEST(PlaneExtent, TwoCoplanarTablesAreTwoRegionsOfOnePlane)
+{
+  Scene scene;
+  scene.addRectangle({2.0, 0, 0}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 3.0, 3.0, "floor");
+  scene.addBox({2.2, -0.8, 0.36}, {0.4, 0.4, 0.36}, 0.0, "left");
+  scene.addBox({2.2, 0.8, 0.36}, {0.4, 0.4, 0.36}, 0.0, "right");
+  const SceneRenderer renderer(scene);
+  PlaneDetector detector{DetectorParams()};
+  KinectNoise noise;
+  for (int f = 0; f < 8; ++f)
+  {
+    const RenderedFrame frame = renderer.render(lookAt({0.0, 0.05 * f, 1.6}, {2.2, 0.0, 0.5}), noise, 900 + f);
+    std::string error;
+    ASSERT_TRUE(detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f, &error)) << error;
+  }
+  const DetectedPlane* tops = nullptr;
+  for (const auto& p : detector.planes())
+    if (std::abs(p.normal.z()) > 0.999 && std::abs(std::abs(p.d) - 0.72) < 0.02) tops = &p;
+  ASSERT_NE(tops, nullptr) << "the tables' plane";
+  const auto regions = detector.regions(*tops);
+  ASSERT_EQ(regions.size(), 2u);
+  bool left = false, right = false;
+  for (const auto& region : regions)
+  {
+    double y_min = 1e9, y_max = -1e9;
+    for (const auto& v : region)
+    {
+      EXPECT_NEAR(v.z(), 0.72, 0.03);
+      EXPECT_NEAR(v.x(), 2.2, 0.46);
+      y_min = std::min(y_min, v.y());
+      y_max = std::max(y_max, v.y());
+    }
+    left |= y_min > -1.26 && y_max < -0.34;
+    right |= y_min > 0.34 && y_max < 1.26;
+  }
+  EXPECT_TRUE(left && right) << "each region lies on its own table";
+  double hull_y_min = 1e9, hull_y_max = -1e9;
+  for (const auto& v : detector.hull(*tops))
+  {
+    hull_y_min = std::min(hull_y_min, v.y());
+    hull_y_max = std::max(hull_y_max, v.y());
+  }
+  EXPECT_LT(hull_y_min, -0.4);
+  EXPECT_GT(hull_y_max, 0.4) << "the single hull spans the gap the regions leave";
+}

@@ -18,6 +18,23 @@ std::vector<RenderedFrame> stillCamera(const SceneRenderer& renderer, const Eige
   return frames;
 }
 
+// A 7 x 4 m hall (floor, east and west walls at x = +-3.5) and a camera in its middle looking
+// at one wall, then the other.
+struct Hall
+{
+  Hall()
+  {
+    Scene hall;
+    hall.addRectangle({0, 0, 0}, kX, kY, 6.0, 4.0, "floor");
+    hall.addRectangle({3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "east");
+    hall.addRectangle({-3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "west");
+    const SceneRenderer renderer(hall);
+    east = stillCamera(renderer, lookAt({0, 0, 1.2}, {3.5, 0.3, 0.9}), 10);
+    west = stillCamera(renderer, lookAt({0, 0, 1.2}, {-3.5, -0.3, 0.9}), 20);
+  }
+  std::vector<RenderedFrame> east, west;
+};
+
 DetectorParams forgettingBy(int forgetting)
 {
   DetectorParams params;
@@ -31,13 +48,9 @@ DetectorParams forgettingBy(int forgetting)
 // loses it (paper 3.7: every cell loses thinning_rate per frame).
 TEST(PlaneEvidence, ALookedAwayWallStaysForAThousandFrames)
 {
-  Scene hall;
-  hall.addRectangle({0, 0, 0}, kX, kY, 6.0, 4.0, "floor");
-  hall.addRectangle({3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "east");
-  hall.addRectangle({-3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "west");
-  const SceneRenderer renderer(hall);
-  const auto east = stillCamera(renderer, lookAt({0, 0, 1.2}, {3.5, 0.3, 0.9}), 10);
-  const auto west = stillCamera(renderer, lookAt({0, 0, 1.2}, {-3.5, -0.3, 0.9}), 20);
+  const Hall hall;
+  const auto& east = hall.east;
+  const auto& west = hall.west;
   for (int forgetting : {kForgetByEvidence, kForgetByThinning})
   {
     PlaneDetector detector(forgettingBy(forgetting));
@@ -73,13 +86,9 @@ TEST(PlaneEvidence, ALookedAwayWallStaysForAThousandFrames)
 // it fades as with thinning (a plane one glance suggested must not stay for good).
 TEST(PlaneEvidence, APlaneGlimpsedTwiceFadesOutOfView)
 {
-  Scene hall;
-  hall.addRectangle({0, 0, 0}, kX, kY, 6.0, 4.0, "floor");
-  hall.addRectangle({3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "east");
-  hall.addRectangle({-3.5, 0, 1.5}, kY, kZ, 4.0, 1.5, "west");
-  const SceneRenderer renderer(hall);
-  const auto east = stillCamera(renderer, lookAt({0, 0, 1.2}, {3.5, 0.3, 0.9}), 10);
-  const auto west = stillCamera(renderer, lookAt({0, 0, 1.2}, {-3.5, -0.3, 0.9}), 20);
+  const Hall hall;
+  const auto& east = hall.east;
+  const auto& west = hall.west;
   PlaneDetector detector(forgettingBy(kForgetByEvidence));
   int f = 0;
   for (int i = 0; i < 2; ++i, ++f) feed(detector, east[f % 4], 0.033 * f);

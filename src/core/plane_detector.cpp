@@ -1273,6 +1273,12 @@ void PlaneDetector::thinByEvidence(float cap)
   }
 }
 
+std::vector<std::vector<Eigen::Vector3d>> PlaneDetector::regions(const DetectedPlane& plane) const
+{
+  const PlaneExtent* e = extent(plane.id);
+  return e ? e->regions(frame_count_, extentFade()) : std::vector<std::vector<Eigen::Vector3d>>();
+}
+
 std::vector<Eigen::Vector3d> PlaneDetector::hull(const DetectedPlane& plane) const
 {
   const PlaneExtent* e = extent(plane.id);

@@ -52,13 +52,62 @@ void PlaneExtent::sweep(int64_t frame, float fade)
 
 std::vector<Eigen::Vector3d> PlaneExtent::hull(int64_t frame, float fade) const
 {
+  std::vector<std::pair<int32_t, int32_t>> live;
+  for (const auto& cell : cells_)
+    if (weightAt(cell.second, frame, fade) > 0.0f)
+      live.emplace_back(static_cast<int32_t>(cell.first >> 32), static_cast<int32_t>(cell.first & 0xffffffffu));
+  return hullOf(live);
+}
+
+std::vector<std::vector<Eigen::Vector3d>> PlaneExtent::regions(int64_t frame, float fade) const
+{
+  // Live cells within kRegionGap cells of each other are one region: far blocks mark cells a
+  // few centimetres apart, while two tables or two rooms' floors lie metres apart.
+  constexpr int32_t kRegionGap = 2;
+  constexpr size_t kMinRegionCells = 4;
+  std::unordered_map<uint64_t, int> label;  // live cell -> region (-1: not yet visited)
+  for (const auto& cell : cells_)
+    if (weightAt(cell.second, frame, fade) > 0.0f) label.emplace(cell.first, -1);
+  std::vector<std::vector<Eigen::Vector3d>> out;
+  std::vector<std::pair<int32_t, int32_t>> region, queue;
+  int next = 0;
+  for (auto& seed : label)
+  {
+    if (seed.second >= 0) continue;
+    seed.second = next;
+    queue.assign(1, {static_cast<int32_t>(seed.first >> 32), static_cast<int32_t>(seed.first & 0xffffffffu)});
+    region.clear();
+    while (!queue.empty())
+    {
+      const auto c = queue.back();
+      queue.pop_back();
+      region.push_back(c);
+      for (int32_t dx = -kRegionGap; dx <= kRegionGap; ++dx)
+        for (int32_t dy = -kRegionGap; dy <= kRegionGap; ++dy)
+        {
+          const auto it = label.find(key(c.first + dx, c.second + dy));
+          if (it == label.end() || it->second >= 0) continue;
+          it->second = next;
+          queue.emplace_back(c.first + dx, c.second + dy);
+        }
+    }
+    ++next;
+    if (region.size() >= kMinRegionCells) out.push_back(hullOf(region));
+  }
+  // Largest first, so that the order does not depend on the hash map's.
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    return a.size() != b.size() ? a.size() > b.size() : a.front().x() < b.front().x();
+  });
+  return out;
+}
+
+std::vector<Eigen::Vector3d> PlaneExtent::hullOf(const std::vector<std::pair<int32_t, int32_t>>& live) const
+{
   if (!basis_) return {};
   // Only the outermost live cell of each row can be on the hull.
   std::map<int32_t, std::pair<int32_t, int32_t>> rows;
-  for (const auto& cell : cells_)
+  for (const auto& [x, y] : live)
   {
-    if (weightAt(cell.second, frame, fade) <= 0.0f) continue;
-    const int32_t x = static_cast<int32_t>(cell.first >> 32), y = static_cast<int32_t>(cell.first & 0xffffffffu);
     auto it = rows.find(y);
     if (it == rows.end())
       rows.emplace(y, std::make_pair(x, x));

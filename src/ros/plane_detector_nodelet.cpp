@@ -277,6 +277,7 @@ private:
     for (const DetectedPlane& p : detector_->planes())
     {
       const std::vector<Eigen::Vector3d> hull = detector_->hull(p);
+      const std::vector<std::vector<Eigen::Vector3d>> regions = detector_->regions(p);
       Plane msg;
       msg.id = p.id;
       msg.coef.coef = {p.normal.x(), p.normal.y(), p.normal.z(), p.d};
@@ -298,8 +299,21 @@ private:
         q.z = v.z();
         msg.hull.points.push_back(q);
       }
+      for (const auto& region : regions)
+      {
+        geometry_msgs::Polygon polygon;
+        for (const auto& v : region)
+        {
+          geometry_msgs::Point32 q;
+          q.x = v.x();
+          q.y = v.y();
+          q.z = v.z();
+          polygon.points.push_back(q);
+        }
+        msg.regions.push_back(polygon);
+      }
       planes->planes.push_back(msg);
-      appendPlaneMarkers(header, p, hull, markers->markers);
+      appendPlaneMarkers(header, p, regions, markers->markers);
     }
     planes_pub_.publish(planes);
     markers_pub_.publish(markers);

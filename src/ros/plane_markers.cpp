@@ -66,28 +66,39 @@ visualization_msgs::Marker baseMarker(const std_msgs::Header& header, const char
 }  // namespace
 
 void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane,
-                        const std::vector<Eigen::Vector3d>& hull, std::vector<visualization_msgs::Marker>& markers)
+                        const std::vector<std::vector<Eigen::Vector3d>>& regions,
+                        std::vector<visualization_msgs::Marker>& markers)
 {
-  if (hull.size() < 3) return;  // not seen enough yet to have an extent
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const auto& v : hull) centre += v;
-  centre /= static_cast<double>(hull.size());
+  if (regions.empty() || regions.front().size() < 3) return;  // not seen enough yet to have an extent
+  auto centreOf = [](const std::vector<Eigen::Vector3d>& polygon) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const auto& v : polygon) centre += v;
+    return Eigen::Vector3d(centre / static_cast<double>(polygon.size()));
+  };
+  const Eigen::Vector3d centre = centreOf(regions.front());  // of the largest region
 
+  // One patch and one outline marker per plane, covering all its regions.
   visualization_msgs::Marker patch = baseMarker(header, "patches", plane.id, visualization_msgs::Marker::TRIANGLE_LIST);
   patch.color = colourForId(plane.id, 0.45f);
-  for (size_t i = 0; i < hull.size(); ++i)  // the hull is convex: a fan around its centre
-  {
-    patch.points.push_back(toPoint(centre));
-    patch.points.push_back(toPoint(hull[i]));
-    patch.points.push_back(toPoint(hull[(i + 1) % hull.size()]));
-  }
-  markers.push_back(patch);
-
-  visualization_msgs::Marker outline = baseMarker(header, "outlines", plane.id, visualization_msgs::Marker::LINE_STRIP);
+  visualization_msgs::Marker outline = baseMarker(header, "outlines", plane.id, visualization_msgs::Marker::LINE_LIST);
   outline.scale.x = 0.02;
   outline.color = colourForId(plane.id, 1.0f);
-  for (const auto& v : hull) outline.points.push_back(toPoint(v));
-  outline.points.push_back(toPoint(hull.front()));
+  for (const std::vector<Eigen::Vector3d>& hull : regions)
+  {
+    if (hull.size() < 3) continue;
+    const Eigen::Vector3d middle = centreOf(hull);
+    for (size_t i = 0; i < hull.size(); ++i)  // each region's hull is convex: a fan around its centre
+    {
+      const Eigen::Vector3d& a = hull[i];
+      const Eigen::Vector3d& b = hull[(i + 1) % hull.size()];
+      patch.points.push_back(toPoint(middle));
+      patch.points.push_back(toPoint(a));
+      patch.points.push_back(toPoint(b));
+      outline.points.push_back(toPoint(a));
+      outline.points.push_back(toPoint(b));
+    }
+  }
+  markers.push_back(patch);
   markers.push_back(outline);
 
   visualization_msgs::Marker arrow = baseMarker(header, "normals", plane.id, visualization_msgs::Marker::ARROW);

@@ -44,6 +44,10 @@ public:
   void sweep(int64_t frame, float fade_per_frame);
   // Convex hull of the live cells, counter-clockwise about the normal, in the world frame.
   std::vector<Eigen::Vector3d> hull(int64_t frame, float fade_per_frame) const;
+  // One convex hull per connected region of live cells (cells up to 10 cm apart connect;
+  // regions of fewer than 4 cells are left out), largest first: two tables at one height, or
+  // two rooms' floors, are two regions of one plane.
+  std::vector<std::vector<Eigen::Vector3d>> regions(int64_t frame, float fade_per_frame) const;
   size_t cellCount() const { return cells_.size(); }
   // Calls f(centre) with the world-frame centre of every live cell (unordered) whose
   // coordinates are multiples of `every` (2: a 10 cm lattice).
@@ -77,6 +81,7 @@ private:
     return (static_cast<uint64_t>(static_cast<uint32_t>(x)) << 32) | static_cast<uint32_t>(y);
   }
   static float weightAt(const Cell& c, int64_t frame, float fade) { return c.weight - fade * (frame - c.seen); }
+  std::vector<Eigen::Vector3d> hullOf(const std::vector<std::pair<int32_t, int32_t>>& cells) const;
   std::unordered_map<uint64_t, Cell> cells_;
   std::shared_ptr<const PlaneBasis> basis_;
 };

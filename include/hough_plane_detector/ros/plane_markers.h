@@ -21,10 +21,12 @@ namespace hough_plane_detector
 std_msgs::ColorRGBA colourForId(int id, float alpha);
 // DELETEALL, sent first in every array so that no marker of a vanished plane stays.
 visualization_msgs::Marker deleteAllMarker(const std_msgs::Header& header);
-// Per plane: filled patch (TRIANGLE_LIST, ns "patches"), outline (LINE_STRIP, "outlines"),
-// normal (ARROW, "normals") and id label (TEXT_VIEW_FACING, "labels"); marker id = plane id.
+// Per plane: filled patches of its regions (TRIANGLE_LIST, ns "patches"), their outlines
+// (LINE_LIST, "outlines"), normal (ARROW, "normals") and id label (TEXT_VIEW_FACING, "labels")
+// at its largest region; marker id = plane id.
 void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane,
-                        const std::vector<Eigen::Vector3d>& hull, std::vector<visualization_msgs::Marker>& markers);
+                        const std::vector<std::vector<Eigen::Vector3d>>& regions,
+                        std::vector<visualization_msgs::Marker>& markers);
 // Label of a point on no plane in the segmented cloud (uint32, as PCL's PointXYZRGBL).
 constexpr uint32_t kNoPlaneLabel = 0xFFFFFFFFu;
 // x y z of the frame plus rgb and label (uint32 plane id, kNoPlaneLabel for none) per point.
