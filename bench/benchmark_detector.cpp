@@ -12,6 +12,7 @@
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/core/plane_metrics.h"
 #include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/core/sensor_model.h"
 #include "hough_plane_detector/tools/input_sources.h"
 #include "pcl_comparators.h"
 
@@ -68,6 +69,38 @@ int main(int argc, char** argv)
     std::printf("  %-20s %6.3f ms\n", names[i], median(stage[i]));
     if (i == 3) std::printf("    of which parallel search %6.3f ms (p90 %.3f)\n", median(parallel), percentile(parallel, 0.9));
   }
+  // What the options cost on the same frames: the paper's windows instead of block regions,
+  // and forgetting by evidence (its check of the map's planes against each frame).
+  auto variantMedians = [&](const DetectorParams& params, std::vector<double>* evidence_ms) {
+    PlaneDetector variant(params);
+    std::vector<double> total;
+    for (int lap = 0; lap < 2; ++lap)
+      for (int f = 0; f < frames; ++f)
+      {
+        variant.processFrame(rendered[f].view(), rendered[f].camera_to_world, lap * frames + f);
+        total.push_back(variant.lastTimings().total_ms);
+        if (evidence_ms) evidence_ms->push_back(variant.lastTimings().evidence_ms);
+      }
+    return median(total);
+  };
+  DetectorParams windows, evidence;
+  windows.region_growing = 0;
+  evidence.forgetting = kForgetByEvidence;
+  std::vector<double> evidence_ms;
+  const double windows_total = variantMedians(windows, nullptr);
+  const double evidence_total = variantMedians(evidence, &evidence_ms);
+  std::printf("  region_growing 0 (the paper's windows): total %6.3f ms\n", windows_total);
+  std::printf("  forgetting 1 (by evidence): total %6.3f ms, of which the evidence check %.3f ms (p90 %.3f)\n",
+              evidence_total, median(evidence_ms), percentile(evidence_ms, 0.9));
+  std::vector<double> intrinsics_ms;
+  for (int f = 0; f < frames; ++f)
+  {
+    const auto start = std::chrono::steady_clock::now();
+    const PinholeIntrinsics k = estimateIntrinsics(rendered[f].view());
+    intrinsics_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    if (!k.valid()) std::printf("  no projection fitted to frame %d\n", f);
+  }
+  std::printf("  of the normals: the projection fitted to the cloud %.3f ms\n", median(intrinsics_ms));
   const MemoryReport mem = detector.memory();
   std::printf("Hough space (resolution 1024): %.2f MB in %zu chunks = %.3f %% of the dense %.0f MB array "
               "(%.4f %% of a 1024^3 float array)\n\n",
