@@ -98,6 +98,41 @@ TEST(PlaneEvidence, APlaneGlimpsedTwiceFadesOutOfView)
   EXPECT_EQ(matching(detector.planes(), kX, 3.5, 0.01, 0.02).size(), 1u) << describe(detector.planes());
 }
 
+// A far wall seen only through a doorway, then the camera steps aside: the far wall's cells now
+// lie behind the near wall (something in front: no evidence), so 300 frames do not clear it.
+TEST(PlaneEvidence, AWallSeenThroughADoorwayIsNotClearedByFramesThatCannotSeeIt)
+{
+  Scene scene;
+  scene.addRectangle({2.0, 0, 0}, kX, kY, 4.0, 4.0, "floor");
+  scene.addRectangle({2.0, -2.25, 1.5}, kY, kZ, 1.75, 1.5, "near wall, left of the door");
+  scene.addRectangle({2.0, 2.25, 1.5}, kY, kZ, 1.75, 1.5, "near wall, right of the door");
+  scene.addRectangle({2.0, 0.0, 2.5}, kY, kZ, 0.5, 0.5, "near wall, over the door");
+  scene.addRectangle({5.0, 0.0, 1.5}, kY, kZ, 1.5, 1.5, "far wall");
+  const SceneRenderer renderer(scene);
+  const auto through = stillCamera(renderer, lookAt({0, 0, 1.2}, {2.0, 0.0, 1.0}), 50);
+  // Aside, the camera looks toward the far wall, but the near wall stands in front of it.
+  const auto aside = stillCamera(renderer, lookAt({0, -3.0, 1.2}, {5.0, 0.0, 1.0}), 60);
+  for (int forgetting : {kForgetByEvidence, kForgetByThinning})
+  {
+    PlaneDetector detector(forgettingBy(forgetting));
+    int f = 0;
+    for (int i = 0; i < 12; ++i, ++f) feed(detector, through[f % 4], 0.033 * f);  // below permanence_cap
+    ASSERT_EQ(matching(detector.planes(), kX, -5.0, 0.01, 0.02).size(), 1u) << "far wall" << describe(detector.planes());
+    for (int i = 0; i < 300; ++i, ++f) feed(detector, aside[f % 4], 0.033 * f);
+    EXPECT_EQ(matching(detector.planes(), kX, -2.0, 0.01, 0.02).size(), 1u) << "near wall" << describe(detector.planes());
+    const auto far = matching(detector.planes(), kX, -5.0, 0.01, 0.02);
+    if (forgetting == kForgetByEvidence)
+    {
+      ASSERT_EQ(far.size(), 1u) << "the far wall was cleared" << describe(detector.planes());
+      EXPECT_EQ(far.front()->contradictions, 0);
+    }
+    else
+    {
+      EXPECT_TRUE(far.empty()) << "thinning kept the far wall: the test no longer shows the difference";
+    }
+  }
+}
+
 // A still camera watches a box on the floor before a wall; at frame 40 the box is taken away.
 // By evidence its top and front leave the map within 30 frames of seeing the floor and wall
 // where they were, while the floor and wall stay; with thinning they stay (permanent cells).
