@@ -34,17 +34,10 @@ PointMoments centroidMoments(const PointMoments& block)
   return m;
 }
 
-PointMoments weightedCentroidMoments(const NormalEstimator& grid, const std::vector<BlockInfo>& info,
-                                     const std::vector<int>& blocks)
+PointMoments weightedCentroidMoments(const std::vector<BlockInfo>& info, const std::vector<int>& blocks)
 {
-  const int bx_count = grid.blocksX();
   PointMoments sum;
-  for (int b : blocks)
-  {
-    PointMoments m = centroidMoments(grid.block(b % bx_count, b / bx_count));
-    m.scale(info[b].fit_weight);
-    sum.add(m);
-  }
+  for (int b : blocks) sum.add(info[b].weighted_centroid);
   return sum;
 }
 
@@ -71,6 +64,8 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
     i.tight_residual = noise_aware ? 0.01 + 3.0 * std::sqrt(i.centroid_variance) : params.support_distance;
     i.thickness_limit = noise_aware ? 6.25 * sigma * sigma + 1e-4 : 0.25 * params.support_distance * params.support_distance;
     i.fit_weight = 1.0 / (sigma * sigma + 1e-6);
+    i.weighted_centroid = centroidMoments(block);
+    i.weighted_centroid.scale(i.fit_weight);
     const double systematic = kSystematicPerSquareMetre * i.centroid.z() * i.centroid.z();
     const double block_sigma = std::max(kMinBlockSigma, sigma);
     i.region_residual = 3.0 * std::sqrt(block_sigma * block_sigma / block.count + step * step / 12.0 + systematic * systematic);
@@ -218,7 +213,7 @@ bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen:
 bool BlockRegionGrower::fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const
 {
   if (blocks.size() < 3) return false;
-  const PointMoments sum = weightedCentroidMoments(grid_, info_, blocks);
+  const PointMoments sum = weightedCentroidMoments(info_, blocks);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(sum.covariance());
   // Centroids along one line (a row of blocks) fix no plane.

@@ -486,7 +486,7 @@ bool PlaneDetector::halvesAgree(const std::vector<int>& blocks, size_t begin, si
 
 PointMoments PlaneDetector::weightedMoments(const std::vector<int>& blocks) const
 {
-  return weightedCentroidMoments(normals_, block_info_, blocks);
+  return weightedCentroidMoments(block_info_, blocks);
 }
 
 PointMoments PlaneDetector::keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,

@@ -54,6 +54,9 @@ double nominalFocalLength(int model)
 DepthNoiseModel::DepthNoiseModel(int model, double coefficient, double focal_px)
   : model_(model), coefficient_(coefficient), focal_px_(focal_px > 0.0 ? focal_px : nominalFocalLength(model))
 {
+  // Asked thousands of times a frame (every block, window and extent cell).
+  sigma_table_.resize(kTableSize);
+  for (int i = 0; i < kTableSize; ++i) sigma_table_[i] = computeSigma(static_cast<double>(i) / kTableStepsPerMetre);
 }
 
 double DepthNoiseModel::quantizationStep(double depth) const
@@ -62,7 +65,7 @@ double DepthNoiseModel::quantizationStep(double depth) const
   return depth * depth / (focal_px_ * kStructuredLightBaseline * kStructuredLightSubpixel);
 }
 
-double DepthNoiseModel::sigma(double depth) const
+double DepthNoiseModel::computeSigma(double depth) const
 {
   if (!enabled()) return 0.0;
   double random = 0.0;

@@ -29,6 +29,7 @@ struct BlockInfo
   double region_residual = 0;    // farthest it may lie from its region's plane: noise and systematic error
   double thickness_limit = 0;    // largest spread along the plane normal
   double fit_weight = 1;         // inverse depth-noise variance
+  PointMoments weighted_centroid;  // its points moved to their centroid, weighted by fit_weight
 };
 
 // Fills `info` (row-major over the estimator's block grid) from the estimator's last frame.
@@ -57,9 +58,9 @@ std::vector<int> interiorBlocks(const std::vector<int>& blocks, int bx_count, in
 PointMoments centroidMoments(const PointMoments& block);
 
 // Centroid moments of the blocks, each weighted by the inverse variance of the sensor at its
-// depth: far points of a Kinect are an order of magnitude noisier, the precise ones decide.
-PointMoments weightedCentroidMoments(const NormalEstimator& grid, const std::vector<BlockInfo>& info,
-                                     const std::vector<int>& blocks);
+// depth (BlockInfo::weighted_centroid): far points of a Kinect are an order of magnitude
+// noisier, the precise ones decide.
+PointMoments weightedCentroidMoments(const std::vector<BlockInfo>& info, const std::vector<int>& blocks);
 
 struct PlaneRegion
 {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "hough_plane_detector/core/cloud_view.h"
 
@@ -32,8 +33,18 @@ public:
   // takes the sensor's nominal VGA focal length.
   explicit DepthNoiseModel(int model = kKinectV1, double coefficient = 1.0, double focal_px = 0.0);
 
-  // Standard deviation of a depth measurement at depth z (m), quantization included.
-  double sigma(double depth) const;
+  // Standard deviation of a depth measurement at depth z (m), quantization included; from a
+  // table of 1 cm steps up to 12 m (linear between them: the curves are smooth), computed above.
+  double sigma(double depth) const
+  {
+    const double at = depth * kTableStepsPerMetre;
+    if (!(at >= 0.0) || at >= kTableSize - 1) return computeSigma(depth);
+    const int i = static_cast<int>(at);
+    const double w = at - i;
+    return (1.0 - w) * sigma_table_[i] + w * sigma_table_[i + 1];
+  }
+  // The same without the table.
+  double computeSigma(double depth) const;
   // Depth step of the sensor's disparity quantization at depth z (0 where it has none).
   double quantizationStep(double depth) const;
   bool enabled() const { return coefficient_ > 0.0; }
@@ -41,9 +52,12 @@ public:
   int model() const { return model_; }
 
 private:
+  static constexpr int kTableStepsPerMetre = 100;
+  static constexpr int kTableSize = 12 * kTableStepsPerMetre + 1;
   int model_;
   double coefficient_;
   double focal_px_;
+  std::vector<double> sigma_table_;
 };
 
 // Eq. 11 of the paper: a Kinect's random depth noise (m) at depth z for noise coefficient C.
