@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -33,13 +34,9 @@ struct RunResult
 
 RunResult run(const std::string& args)
 {
-  const std::string command = std::string(DETECT_PLANES_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string output;
-  char buffer[4096];
-  while (pipe && fgets(buffer, sizeof(buffer), pipe)) output += buffer;
-  const int status = pipe ? pclose(pipe) : -1;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  RunResult result;
+  result.output = runCommand(std::string(DETECT_PLANES_BINARY) + " " + args, &result.exit_code);
+  return result;
 }
 
 std::string tempPath(const std::string& name)
@@ -233,5 +230,52 @@ TEST(DetectPlanesCli, RefusesFilesThatAreNotPcd)
     const RunResult r = run(path);
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find(cases[i].second), std::string::npos) << r.output;
+  }
+}
+
+// A TUM-layout bag: 32FC1 depth images with their camera_info and tf1-era frame ids become
+// clouds; the recording's stamps are kept and the room's large planes found. Depth images that
+// cannot become clouds are skipped with a message naming why, and so is a bag without any.
+TEST(DetectPlanesCli, ReadsADepthImageBagAndRefusesBadDepthImages)
+{
+  const std::string bag = tempPath("tum.bag");
+  const std::vector<TruePlane> truth = writeTumBag(bag, 6);
+  RunResult r = run("--bag " + bag + " --topic /camera/depth/image --world-frame world");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto frames = parseFrames(r.output);
+  ASSERT_EQ(frames.size(), 6u) << r.output;
+  double last_stamp = 0.0;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);)
+    if (!line.empty() && line[0] == '{') last_stamp = nlohmann::json::parse(line).at("stamp").get<double>();
+  EXPECT_NEAR(last_stamp, kTumStart + 5 / 30.0, 1e-6) << "the recording's stamps, to the microsecond";
+  ASSERT_GE(truth.size(), 2u);
+  for (const TruePlane& t : truth) EXPECT_TRUE(hasPlane(frames.back(), t.normal, t.d)) << t.name << "\n" << r.output;
+
+  // A camera_info topic named apart, given by --camera-info; a wrong one is named.
+  r = run("--bag " + bag + " --topic /camera/depth/image --world-frame world --camera-info /nowhere/camera_info");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("/nowhere/camera_info is not in"), std::string::npos) << r.output;
+
+  struct Case
+  {
+    const char* name;
+    std::function<void(sensor_msgs::Image&, sensor_msgs::CameraInfo&)> spoil;
+    const char* expected;
+  };
+  const std::vector<Case> cases = {
+      {"colour", [](sensor_msgs::Image& i, sensor_msgs::CameraInfo&) { i.encoding = "rgb8"; }, "encoding 'rgb8'"},
+      {"zeros", [](sensor_msgs::Image&, sensor_msgs::CameraInfo& c) { c.K.fill(0.0); }, "no focal length"},
+      {"size", [](sensor_msgs::Image&, sensor_msgs::CameraInfo& c) { c.width = 320; }, "does not match its camera_info"},
+      {"short", [](sensor_msgs::Image& i, sensor_msgs::CameraInfo&) { i.data.resize(i.data.size() / 2); }, "too few"},
+  };
+  for (const Case& c : cases)
+  {
+    const std::string spoilt = tempPath(std::string("tum_") + c.name + ".bag");
+    writeTumBag(spoilt, 2, c.spoil);
+    r = run("--bag " + spoilt + " --topic /camera/depth/image --world-frame world");
+    EXPECT_EQ(r.exit_code, 1) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.name << ": " << r.output;
+    EXPECT_NE(r.output.find("skipped: depth image refused"), std::string::npos) << c.name << ": " << r.output;
   }
 }

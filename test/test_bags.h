@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -13,6 +14,8 @@
 #include <nlohmann/json.hpp>
 #include <Eigen/Geometry>
 #include <rosbag/bag.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -107,6 +110,87 @@ inline void writeBag(const std::string& path, int frames, bool (*tf_for_frame)(i
     bag.write("/tf", ros::Time(stamp), tf);
   }
   bag.close();
+}
+
+// A recording in the TUM RGB-D layout: 32FC1 depth images in metres with NaN holes, their
+// camera_info, tf1-era frame ids with a leading '/'.
+constexpr double kTumStart = 1305031102.175304;  // a freiburg1 recording's first stamp
+constexpr int kTumFrames = 12;
+
+inline sensor_msgs::Image toDepthImage(const RenderedFrame& frame, const std::string& frame_id, double stamp)
+{
+  sensor_msgs::Image image;
+  image.header.frame_id = frame_id;
+  image.header.stamp.fromSec(stamp);
+  image.width = frame.width;
+  image.height = frame.height;
+  image.encoding = "32FC1";
+  image.step = 4 * frame.width;
+  image.data.resize(static_cast<size_t>(image.step) * frame.height);
+  for (size_t i = 0; i < static_cast<size_t>(frame.width) * frame.height; ++i)
+  {
+    const float z = frame.xyz[i * 3 + 2];  // NaN where the sensor saw nothing, as TUM's bags
+    std::memcpy(&image.data[i * 4], &z, 4);
+  }
+  return image;
+}
+
+inline sensor_msgs::CameraInfo toCameraInfo(const CameraIntrinsics& k, const std::string& frame_id, double stamp)
+{
+  sensor_msgs::CameraInfo info;
+  info.header.frame_id = frame_id;
+  info.header.stamp.fromSec(stamp);
+  info.width = k.width;
+  info.height = k.height;
+  info.distortion_model = "plumb_bob";
+  info.D.assign(5, 0.0);
+  info.K = {k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+// /world -> /kinect (the motion capture's camera body, x forward) -> /openni_depth_optical_frame,
+// everything on /tf as in TUM's bags, `frames` frames at 30 Hz from kTumStart; `change` may
+// spoil each image and camera_info before they are written (bad-input tests). Returns the
+// planes with 20,000 points in the last frame.
+inline std::vector<TruePlane> writeTumBag(
+    const std::string& path, int frames,
+    const std::function<void(sensor_msgs::Image&, sensor_msgs::CameraInfo&)>& change = nullptr)
+{
+  const SceneRenderer renderer(makeOfficeRoom());
+  const auto poses = roomTour(40);
+  Eigen::Isometry3d body_to_optical = Eigen::Isometry3d::Identity();
+  body_to_optical.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  rosbag::Bag bag(path, rosbag::bagmode::Write);
+  std::vector<TruePlane> seen;
+  KinectNoise noise;
+  noise.coefficient = 0.5;
+  for (int f = 0; f < frames; ++f)
+  {
+    const double stamp = kTumStart + f / 30.0;
+    const RenderedFrame frame = renderer.render(poses[f], noise, 500 + f);
+    seen.clear();
+    for (size_t t = 0; t < renderer.truePlanes().size(); ++t)
+      if (frame.visible_points[t] >= 20000) seen.push_back(renderer.truePlanes()[t]);
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(toTransform(poses[f] * body_to_optical.inverse(), "/world", "/kinect", stamp));
+    tf.transforms.push_back(toTransform(body_to_optical, "/kinect", "/openni_depth_optical_frame", stamp));
+    bag.write("/tf", ros::Time(stamp), tf);
+    sensor_msgs::Image image = toDepthImage(frame, "/openni_depth_optical_frame", stamp);
+    sensor_msgs::CameraInfo info = toCameraInfo(renderer.intrinsics(), "/openni_depth_optical_frame", stamp);
+    if (change) change(image, info);
+    bag.write("/camera/depth/image", ros::Time(stamp), image);
+    bag.write("/camera/depth/camera_info", ros::Time(stamp), info);
+  }
+  // Transforms a little later, so the last image is not left waiting when play exits.
+  tf2_msgs::TFMessage tf;
+  const double last = kTumStart + (frames - 1) / 30.0 + 0.5;
+  tf.transforms.push_back(toTransform(poses[frames - 1] * body_to_optical.inverse(), "/world", "/kinect", last));
+  tf.transforms.push_back(toTransform(body_to_optical, "/kinect", "/openni_depth_optical_frame", last));
+  bag.write("/tf", ros::Time(last), tf);
+  bag.close();
+  return seen;
 }
 
 // Runs a shell command; its stdout and stderr, and its exit code (-1 when it did not exit).

@@ -19,14 +19,16 @@ void usage(std::ostream& out)
          "       detect_planes FILE.pcd [FILE.pcd ...] [options]\n"
          "options:\n"
          "  --out FILE            write the JSON lines to FILE instead of stdout\n"
-         "  --world-frame FRAME   frame the planes are reported in (bag input; default odom)\n";
+         "  --world-frame FRAME   frame the planes are reported in (bag input; default odom)\n"
+         "  --camera-info TOPIC   camera_info of a depth-image topic (sensor_msgs/Image, 16UC1 mm or 32FC1 m;\n"
+         "                        default: the camera_info beside the image topic)\n";
   for (const std::string& line : detectorParamHelp()) out << "  " << line << "\n";
 }
 }  // namespace
 
 int main(int argc, char** argv)
 {
-  std::string bag_path, topic, world_frame = "odom", out_path;
+  std::string bag_path, topic, world_frame = "odom", out_path, camera_info_topic;
   std::vector<std::string> pcd_paths;
   DetectorParams params;
   for (int i = 1; i < argc; ++i)
@@ -48,6 +50,7 @@ int main(int argc, char** argv)
       if (arg == "--bag") bag_path = value;
       else if (arg == "--topic") topic = value;
       else if (arg == "--world-frame") world_frame = value;
+      else if (arg == "--camera-info") camera_info_topic = value;
       else if (arg == "--out") out_path = value;
       else
       {
@@ -137,7 +140,7 @@ int main(int argc, char** argv)
 
   BagFrameSource source;
   std::string error;
-  if (!source.open(bag_path, topic, world_frame, &error))
+  if (!source.open(bag_path, topic, world_frame, &error, camera_info_topic))
   {
     std::cerr << "detect_planes: " << error << "\n";
     return 1;
@@ -147,9 +150,9 @@ int main(int argc, char** argv)
   while (source.next(frame))
   {
     const double stamp = frame.cloud->header.stamp.toSec();
-    if (!frame.has_transform)
+    if (!frame.usable)
     {
-      std::cerr << "detect_planes: warning: frame " << frame_index << " skipped: " << frame.transform_error << "\n";
+      std::cerr << "detect_planes: warning: frame " << frame_index << " skipped: " << frame.skip_reason << "\n";
       ++frame_index;
       ++skipped;
       continue;

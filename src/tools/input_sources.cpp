@@ -1,7 +1,10 @@
 #include "hough_plane_detector/tools/input_sources.h"
 #include "hough_plane_detector/tools/pcd_header.h"
 
+#include <cmath>
+#include <cstring>
 #include <fstream>
+#include <limits>
 
 #include <pcl/io/pcd_io.h>
 #include <rosbag/bag.h>
@@ -44,6 +47,87 @@ bool loadPcd(const std::string& path, pcl::PCLPointCloud2& cloud, std::string* e
   return true;
 }
 
+namespace
+{
+std::string withoutLeadingSlash(const std::string& frame)
+{
+  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
+}
+}  // namespace
+
+bool depthImageToCloud(const sensor_msgs::Image& image, const sensor_msgs::CameraInfo& info,
+                       sensor_msgs::PointCloud2& cloud, std::string* error)
+{
+  auto fail = [&](const std::string& what) {
+    if (error) *error = what;
+    return false;
+  };
+  const bool millimetres = image.encoding == "16UC1" || image.encoding == "mono16";
+  const bool metres = image.encoding == "32FC1";
+  if (!millimetres && !metres)
+    return fail("depth image encoding '" + image.encoding + "' is not a depth (16UC1 or mono16 in mm, 32FC1 in m)");
+  if (image.is_bigendian) return fail("big-endian depth images are not read");
+  const double fx = info.K[0], fy = info.K[4], cx = info.K[2], cy = info.K[5];
+  if (!(fx > 0.0 && fy > 0.0) || !std::isfinite(cx + cy))
+    return fail("camera_info has no focal length (K = 0: an uncalibrated or empty camera_info)");
+  if (info.width != 0 && (info.width != image.width || info.height != image.height))
+    return fail("depth image of " + std::to_string(image.width) + " x " + std::to_string(image.height) +
+                " does not match its camera_info of " + std::to_string(info.width) + " x " + std::to_string(info.height));
+  const size_t bytes_per_pixel = millimetres ? 2 : 4;
+  if (image.width == 0 || image.height == 0 || image.step < image.width * bytes_per_pixel ||
+      image.data.size() < static_cast<size_t>(image.step) * image.height)
+    return fail("depth image of " + std::to_string(image.width) + " x " + std::to_string(image.height) + ", step " +
+                std::to_string(image.step) + " holds " + std::to_string(image.data.size()) + " bytes: too few");
+  cloud = sensor_msgs::PointCloud2();
+  cloud.header = image.header;
+  cloud.width = image.width;
+  cloud.height = image.height;
+  cloud.point_step = 12;
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_dense = false;
+  const char* names[3] = {"x", "y", "z"};
+  for (int i = 0; i < 3; ++i)
+  {
+    sensor_msgs::PointField field;
+    field.name = names[i];
+    field.offset = 4 * i;
+    field.datatype = sensor_msgs::PointField::FLOAT32;
+    field.count = 1;
+    cloud.fields.push_back(field);
+  }
+  cloud.data.resize(static_cast<size_t>(cloud.row_step) * cloud.height);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (uint32_t v = 0; v < image.height; ++v)
+  {
+    const uint8_t* row = &image.data[static_cast<size_t>(v) * image.step];
+    for (uint32_t u = 0; u < image.width; ++u)
+    {
+      double z;
+      if (millimetres)
+      {
+        uint16_t mm;
+        std::memcpy(&mm, row + 2 * u, 2);
+        z = mm * 0.001;
+      }
+      else
+      {
+        float m;
+        std::memcpy(&m, row + 4 * u, 4);
+        z = m;
+      }
+      float xyz[3] = {nan, nan, nan};
+      if (std::isfinite(z) && z > 0.0)  // 0 or NaN: no return
+      {
+        xyz[0] = static_cast<float>((u - cx) / fx * z);
+        xyz[1] = static_cast<float>((v - cy) / fy * z);
+        xyz[2] = static_cast<float>(z);
+      }
+      std::memcpy(&cloud.data[(static_cast<size_t>(v) * image.width + u) * 12], xyz, 12);
+    }
+  }
+  return true;
+}
+
 struct BagFrameSource::Impl
 {
   rosbag::Bag bag;
@@ -51,13 +135,15 @@ struct BagFrameSource::Impl
   rosbag::View::iterator it;
   tf2::BufferCore buffer{ros::Duration(1e6)};  // the whole bag stays queryable
   std::string world_frame;
+  std::string topic, camera_info_topic;  // camera_info_topic set for a depth-image topic
+  sensor_msgs::CameraInfo::ConstPtr camera_info;  // the latest one read
 };
 
 BagFrameSource::BagFrameSource() : impl_(new Impl) {}
 BagFrameSource::~BagFrameSource() = default;
 
 bool BagFrameSource::open(const std::string& path, const std::string& topic, const std::string& world_frame,
-                          std::string* error)
+                          std::string* error, const std::string& camera_info_topic)
 {
   if (!std::ifstream(path).good())
   {
@@ -73,27 +159,40 @@ bool BagFrameSource::open(const std::string& path, const std::string& topic, con
     if (error) *error = path + ": not a readable rosbag (" + e.what() + ")";
     return false;
   }
-  impl_->world_frame = world_frame;
+  impl_->world_frame = withoutLeadingSlash(world_frame);
+  impl_->topic = topic;
   try
   {
     rosbag::View all(impl_->bag);
-    bool found = false;
-    std::string topics;
+    std::string topics, type, info_type;
+    const std::string info_topic =
+        !camera_info_topic.empty() ? camera_info_topic : topic.substr(0, topic.find_last_of('/') + 1) + "camera_info";
     for (const rosbag::ConnectionInfo* c : all.getConnections())
     {
       topics += " " + c->topic + " (" + c->datatype + ")";
-      if (c->topic != topic) continue;
-      if (c->datatype != "sensor_msgs/PointCloud2")
-      {
-        if (error) *error = "topic " + topic + " in " + path + " has type " + c->datatype + ", not sensor_msgs/PointCloud2";
-        return false;
-      }
-      found = true;
+      if (c->topic == topic) type = c->datatype;
+      if (c->topic == info_topic) info_type = c->datatype;
     }
-    if (!found)
+    if (type.empty())
     {
       if (error) *error = "topic " + topic + " is not in " + path + "; it has:" + (topics.empty() ? " nothing" : topics);
       return false;
+    }
+    if (type != "sensor_msgs/PointCloud2" && type != "sensor_msgs/Image")
+    {
+      if (error) *error = "topic " + topic + " in " + path + " has type " + type + ", not sensor_msgs/PointCloud2 or sensor_msgs/Image";
+      return false;
+    }
+    if (type == "sensor_msgs/Image")
+    {
+      if (info_type != "sensor_msgs/CameraInfo")
+      {
+        if (error)
+          *error = "depth image topic " + topic + " needs its camera_info: " + info_topic +
+                   (info_type.empty() ? " is not in " + path : " has type " + info_type) + " (give --camera-info TOPIC)";
+        return false;
+      }
+      impl_->camera_info_topic = info_topic;
     }
     rosbag::View tf_view(impl_->bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static"}));
     for (const rosbag::MessageInstance& m : tf_view)
@@ -113,7 +212,9 @@ bool BagFrameSource::open(const std::string& path, const std::string& topic, con
         }
       }
     }
-    impl_->view.reset(new rosbag::View(impl_->bag, rosbag::TopicQuery(topic)));
+    std::vector<std::string> read{topic};
+    if (!impl_->camera_info_topic.empty()) read.push_back(impl_->camera_info_topic);
+    impl_->view.reset(new rosbag::View(impl_->bag, rosbag::TopicQuery(read)));
     impl_->it = impl_->view->begin();
   }
   catch (const rosbag::BagException& e)
@@ -131,17 +232,41 @@ bool BagFrameSource::next(BagFrame& frame)
     const rosbag::MessageInstance m = *impl_->it;  // a copy: the iterator owns what it points to
     ++impl_->it;
     frame = BagFrame();
-    frame.cloud = m.instantiate<sensor_msgs::PointCloud2>();
-    if (!frame.cloud) continue;
-    const std::string& source = frame.cloud->header.frame_id;
+    if (!impl_->camera_info_topic.empty())
+    {
+      if (m.getTopic() == impl_->camera_info_topic)
+      {
+        if (const auto info = m.instantiate<sensor_msgs::CameraInfo>()) impl_->camera_info = info;
+        continue;
+      }
+      const sensor_msgs::Image::ConstPtr image = m.instantiate<sensor_msgs::Image>();
+      if (!image) continue;
+      sensor_msgs::PointCloud2::Ptr cloud(new sensor_msgs::PointCloud2);
+      std::string why = "no camera_info on " + impl_->camera_info_topic + " before this image";
+      if (impl_->camera_info && depthImageToCloud(*image, *impl_->camera_info, *cloud, &why))
+        frame.cloud = cloud;
+      if (!frame.cloud)
+      {
+        cloud->header = image->header;  // the frame still has its stamp and frame id
+        frame.cloud = cloud;
+        frame.skip_reason = "depth image refused: " + why;
+        return true;
+      }
+    }
+    else
+    {
+      frame.cloud = m.instantiate<sensor_msgs::PointCloud2>();
+      if (!frame.cloud) continue;
+    }
+    const std::string source = withoutLeadingSlash(frame.cloud->header.frame_id);
     if (source.empty())
     {
-      frame.transform_error = "cloud has an empty frame_id";
+      frame.skip_reason = "cloud has an empty frame_id";
       return true;
     }
     if (source == impl_->world_frame)
     {
-      frame.has_transform = true;
+      frame.usable = true;
       return true;
     }
     try
@@ -151,12 +276,12 @@ bool BagFrameSource::next(BagFrame& frame)
       const auto& q = t.transform.rotation;
       const auto& p = t.transform.translation;
       frame.camera_to_world = Eigen::Translation3d(p.x, p.y, p.z) * Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
-      frame.has_transform = true;
+      frame.usable = true;
     }
     catch (const tf2::TransformException& e)
     {
-      frame.transform_error = std::string("no transform from ") + source + " to " + impl_->world_frame + " at " +
-                              std::to_string(frame.cloud->header.stamp.toSec()) + ": " + e.what();
+      frame.skip_reason = std::string("no transform from ") + source + " to " + impl_->world_frame + " at " +
+                          std::to_string(frame.cloud->header.stamp.toSec()) + ": " + e.what();
     }
     return true;
   }
