@@ -123,6 +123,55 @@ TEST(MapFile, RefusesBrokenOrForeignFilesAndKeepsTheCurrentMap)
   EXPECT_EQ(target.planes().size(), source.planes().size());
 }
 
+// Forgetting by evidence: each plane's belief (log-odds, confirmations, contradictions) is part
+// of the map (format version 2), so a restored map goes on exactly; a version-1 file (no
+// beliefs) still loads, its planes unconfirmed.
+TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
+{
+  DetectorParams evidence;
+  evidence.forgetting = kForgetByEvidence;
+  PlaneDetector original(evidence);
+  warmUp(original, 8);
+  int64_t confirmations = 0;
+  for (const DetectedPlane& p : original.planes()) confirmations += p.confirmations;
+  ASSERT_GT(confirmations, 0) << "eight frames of the office confirmed its planes";
+  PlaneDetector restored(evidence);
+  std::string error;
+  ASSERT_TRUE(restored.deserializeMap(original.serializeMap(), &error)) << error;
+  SceneRenderer renderer(makeOfficeRoom());
+  for (int f = 8; f < 12; ++f)
+  {
+    const RenderedFrame frame = renderer.render(roomTour(40)[f], KinectNoise(), 99 + f);
+    ASSERT_TRUE(original.processFrame(frame.view(), frame.camera_to_world, f));
+    ASSERT_TRUE(restored.processFrame(frame.view(), frame.camera_to_world, f));
+    expectSameMap(original, restored);
+    for (size_t i = 0; i < original.planes().size(); ++i)
+    {
+      EXPECT_EQ(restored.planes()[i].confirmations, original.planes()[i].confirmations);
+      EXPECT_EQ(restored.planes()[i].contradictions, original.planes()[i].contradictions);
+    }
+  }
+
+  // Version 1: the same bytes without the belief section, version 1, checksum (64-bit FNV-1a) anew.
+  PlaneDetector thinning{DetectorParams()};
+  warmUp(thinning, 4);
+  std::string bytes = thinning.serializeMap();
+  bytes.resize(bytes.size() - sizeof(uint64_t) - sizeof(uint32_t));  // checksum, then a belief count of 0
+  const uint32_t one = 1;
+  std::memcpy(&bytes[8], &one, sizeof(one));
+  uint64_t hash = 1469598103934665603ull;
+  for (char c : bytes)
+  {
+    hash ^= static_cast<unsigned char>(c);
+    hash *= 1099511628211ull;
+  }
+  bytes.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
+  PlaneDetector old_reader(evidence);
+  ASSERT_TRUE(old_reader.deserializeMap(bytes, &error)) << error;
+  expectSameMap(thinning, old_reader);
+  for (const DetectedPlane& p : old_reader.planes()) EXPECT_EQ(p.confirmations, 0);
+}
+
 // Found by fuzz_map_file: a count far beyond the file's size made the loader allocate for it
 // before reading (out of memory). Counts are now checked against the bytes left.
 TEST(MapFile, AbsurdCountsAreRefusedBeforeAllocating)

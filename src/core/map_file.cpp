@@ -14,7 +14,8 @@ namespace hough_plane_detector
 namespace
 {
 constexpr char kMagic[8] = {'H', 'P', 'D', 'M', 'A', 'P', '\n', '\0'};
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;        // 2: plane beliefs (forgetting by evidence) after the extents
+constexpr uint32_t kOldestReadVersion = 1;  // 1: no beliefs; its planes load unconfirmed
 
 uint64_t fnv1a(const char* data, size_t size)
 {
@@ -125,6 +126,18 @@ std::string PlaneDetector::serializeMap() const
       w.put(cell.second.seen);
     }
   }
+  std::vector<int> belief_ids;
+  for (const auto& b : beliefs_) belief_ids.push_back(b.first);
+  std::sort(belief_ids.begin(), belief_ids.end());
+  w.put(static_cast<uint32_t>(belief_ids.size()));
+  for (int id : belief_ids)
+  {
+    const PlaneBelief& belief = beliefs_.at(id);
+    w.put(static_cast<int32_t>(id));
+    w.put(belief.log_odds);
+    w.put(belief.confirmations);
+    w.put(belief.contradictions);
+  }
   return withMapChecksum(w.bytes);
 }
 
@@ -142,9 +155,9 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
   uint32_t version = 0;
   r.getBytes(magic, sizeof(magic));
   r.get(version);
-  if (version != kVersion)
-    return fail("map format version " + std::to_string(version) + " is not the supported version " +
-                std::to_string(kVersion));
+  if (version < kOldestReadVersion || version > kVersion)
+    return fail("map format version " + std::to_string(version) + " is not a supported version (" +
+                std::to_string(kOldestReadVersion) + " to " + std::to_string(kVersion) + ")");
   uint64_t stored_checksum;
   std::memcpy(&stored_checksum, bytes.data() + bytes.size() - sizeof(uint64_t), sizeof(uint64_t));
   if (stored_checksum != fnv1a(bytes.data(), bytes.size() - sizeof(uint64_t)))
@@ -219,6 +232,21 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
       extent.setCell(x, y, cell);
     }
   }
+  std::unordered_map<int, PlaneBelief> beliefs;
+  if (version >= 2)
+  {
+    uint32_t belief_count;
+    constexpr size_t kBeliefBytes = 4 + 8 + 8 + 8;
+    if (!r.get(belief_count) || belief_count > r.remaining() / kBeliefBytes) return fail("map beliefs are truncated");
+    for (uint32_t i = 0; i < belief_count; ++i)
+    {
+      int32_t id;
+      PlaneBelief belief;
+      if (!r.get(id) || !r.get(belief.log_odds) || !r.get(belief.confirmations) || !r.get(belief.contradictions))
+        return fail("map beliefs are truncated");
+      beliefs[id] = belief;
+    }
+  }
   if (r.position() != bytes.size() - sizeof(uint64_t)) return fail("map has trailing bytes");
 
   // Everything read and checked: only now replace the state.
@@ -226,7 +254,14 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
   for (const auto& chunk : chunks)
     std::memcpy(global_.allocateChunk(chunk.first), chunk.second.data(), sizeof(float) * SparseHoughSpace::kChunkCells);
   planes_ = planes;
+  for (DetectedPlane& plane : planes_)
+  {
+    const auto it = beliefs.find(plane.id);
+    plane.confirmations = it != beliefs.end() ? it->second.confirmations : 0;
+    plane.contradictions = it != beliefs.end() ? it->second.contradictions : 0;
+  }
   extents_.swap(extents);
+  beliefs_.swap(beliefs);
   next_id_ = next_id;
   frame_count_ = frame_count;
   samples_.clear();
