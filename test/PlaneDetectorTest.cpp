@@ -465,6 +465,31 @@ TEST(PlaneDetector, NearlyLevelPlanesTakeTheFloorsNormalInsteadOfATiltedTwin)
   }
 }
 
+// The lab's tour (Table 3's path): a bin's tangent strip lies within the noise of a plane of a
+// wall's normal, block by block; the parallel search took it as a wall-parallel plane until the
+// same likelihood-ratio test as the snap's asked whether the known normal explains the strip as
+// well as the strip's own fit (it does not: the strip bends).
+TEST(PlaneDetector, TheLabTourHasNoPlaneOnABin)
+{
+  SceneRenderer renderer(makeClutteredLab());
+  PlaneDetector detector{DetectorParams()};
+  const auto poses = roomTour(60);
+  int visible = 0, detected = 0;
+  for (size_t f = 0; f < poses.size(); ++f)
+  {
+    const RenderedFrame frame = renderer.render(poses[f], kinect(1.0), 11000 + f);
+    feed(detector, frame, 0.1 * f);
+    if (f < 3 || (f - 3) % 3 != 0) continue;
+    std::vector<EvaluatedPlane> planes;
+    for (const auto& p : detector.planes()) planes.push_back({p.normal, p.d});
+    const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, planes);
+    EXPECT_EQ(metrics.false_detections, 0) << "frame " << f << describe(detector.planes());
+    visible += metrics.visible;
+    detected += metrics.detected;
+  }
+  EXPECT_GE(detected, 0.95 * visible) << detected << " of " << visible;
+}
+
 // Two boxes 2 m away, one turned 3 deg from the other: a face of the second is close enough
 // to the first's normal to be snapped, and its blocks scatter about the first's normal little
 // more than their noise (mean chi^2 under 4). The snap's likelihood-ratio test against the

@@ -783,12 +783,17 @@ bool PlaneDetector::snapToKnownDirection(Eigen::Vector3d& normal, double& d, con
   // likelihood-ratio test (2 degrees of freedom, the normal's), else a box face a few degrees
   // off an older box's would take its direction. Judged on the interior: rim blocks straddling
   // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
-  std::vector<int> interior = interiorBlocks(inliers, normals_.blocksX(), normals_.blocksY());
-  if (interior.size() < kMinInteriorBlocks) interior = inliers;
-  if (snapChi2Increase(n_cam, interior) > kMaxSnapChi2Increase) return false;
+  if (!explainedByNormal(n_cam, inliers)) return false;
   normal = known;
   d = d_cam - known.dot(camera_to_world_.translation());
   return true;
+}
+
+bool PlaneDetector::explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+{
+  std::vector<int> interior = interiorBlocks(blocks, normals_.blocksX(), normals_.blocksY());
+  if (interior.size() < kMinInteriorBlocks) interior = blocks;
+  return snapChi2Increase(n_cam, interior) <= kMaxSnapChi2Increase;
 }
 
 double PlaneDetector::snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
@@ -956,7 +961,7 @@ void PlaneDetector::findParallelPlanes(std::vector<Peak>& supported)
       PlaneCandidate candidate{normal, d, 0.0, moments.count, CandidateVerdict::kAccepted, true};
       if (moments.count < params_.parallel_support)
         candidate.verdict = CandidateVerdict::kCurvedPatches;
-      else if (!fitIsParallel(n_cam, blocks))
+      else if (!fitIsParallel(n_cam, blocks) || !explainedByNormal(n_cam, blocks))
         candidate.verdict = CandidateVerdict::kNotParallel;
       if (candidate.verdict == CandidateVerdict::kAccepted)
       {

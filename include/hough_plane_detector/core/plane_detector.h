@@ -206,6 +206,10 @@ private:
   // parallel plane within their noise. True if it did.
   bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
                             const std::vector<Peak>& supported) const;
+  // True when a plane of the camera-frame normal explains the blocks (their interior when it
+  // has kMinInteriorBlocks: rim blocks may straddle a fold) about as well as their own best
+  // plane: a likelihood-ratio test, chi^2 increase below kMaxSnapChi2Increase (2 dof, p = 0.01).
+  bool explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
   // How much more chi^2 the block centroids have about their best plane of the camera-frame
   // normal than about their own best plane (both with the centroids' noise).
   double snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
