@@ -34,9 +34,25 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all deps build test tsan tsan-control fuzz soak soak-control demo demo-offline bench evaluate clean
+.PHONY: all help deps build test tsan tsan-control fuzz soak soak-control demo demo-offline bench evaluate clean
 
 all: build
+
+help:
+	@echo "make deps          install the Debian packages the build, tests and demo need (safe to rerun)"
+	@echo "make build         build the catkin workspace in build/ws (Release)"
+	@echo "make test          build and run every gtest, rostest and fuzz smoke run; prints N passed, N failed"
+	@echo "make test SANITIZE=address,undefined   the same with sanitizers, in its own workspace"
+	@echo "make tsan          ThreadSanitizer on the nodelet under concurrent clouds, reconfigure and services"
+	@echo "make tsan-control  the same on a build that skips the map lock (must report races)"
+	@echo "make fuzz          libFuzzer on cloud views, map files and PCD headers (FUZZ_SECONDS each)"
+	@echo "make demo          simulated Kinect -> detector nodelet -> planes, no hardware"
+	@echo "make demo-offline  the core alone on the simulated room, with per-frame figures"
+	@echo "make bench         time per frame and accuracy against PCL RANSAC and OMPS"
+	@echo "make evaluate      the paper's experiments, held-out rooms, real frames -> docs/RESULTS.md (QUICK=1: short)"
+	@echo "make soak          10,000 frames through the core, then the nodelet (memory, ms, valgrind's leak checks)"
+	@echo "make soak-control  the leak check's negative control (must report a leak)"
+	@echo "make clean         remove build/"
 
 deps:
 	@scripts/install_deps.sh
