@@ -10,8 +10,8 @@
 #include <pcl/PCLPointCloud2.h>
 
 #include "hough_plane_detector/core/plane_detector.h"
-#include "hough_plane_detector/core/plane_metrics.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/core/sensor_model.h"
 #include "hough_plane_detector/tools/input_sources.h"
 #include "pcl_comparators.h"

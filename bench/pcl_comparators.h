@@ -11,7 +11,7 @@
 #include <pcl/point_types.h>
 
 #include "hough_plane_detector/core/cloud_view.h"
-#include "hough_plane_detector/core/plane_metrics.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
 
 namespace hough_plane_detector
 {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "hough_plane_detector/core/plane_detector.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 using namespace hough_plane_detector;
 

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "hough_plane_detector/core/depth_image.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 using namespace hough_plane_detector;
 

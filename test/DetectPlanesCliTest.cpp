@@ -17,7 +17,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/tools/cli_options.h"
 #include "test_bags.h"
 

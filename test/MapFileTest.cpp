@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "hough_plane_detector/core/plane_detector.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 using namespace hough_plane_detector;
 

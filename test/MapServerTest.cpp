@@ -10,7 +10,7 @@
 
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/core/plane_detector.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 using namespace hough_plane_detector;
 

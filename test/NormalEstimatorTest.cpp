@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "hough_plane_detector/core/normal_estimator.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/core/sensor_model.h"
 
 using namespace hough_plane_detector;

@@ -22,7 +22,7 @@
 #include "hough_plane_detector/ModelCoefficientsArray.h"
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/SaveMap.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "reconfigure_request.h"
 
 using namespace hough_plane_detector;

@@ -9,8 +9,8 @@
 #include <stdexcept>
 
 #include "hough_plane_detector/core/plane_detector.h"
-#include "hough_plane_detector/core/plane_metrics.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/core/sensor_model.h"
 
 using namespace hough_plane_detector;

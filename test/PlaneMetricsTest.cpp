@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "hough_plane_detector/core/plane_metrics.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
 
 using namespace hough_plane_detector;
 

@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 
 #include "hough_plane_detector/core/plane_detector.h"
-#include "hough_plane_detector/core/plane_metrics.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 using namespace hough_plane_detector;
 

@@ -9,8 +9,8 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 
 #include "hough_plane_detector/PlaneArray.h"
-#include "hough_plane_detector/core/plane_metrics.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/tools/png_image.h"
 
 using namespace hough_plane_detector;

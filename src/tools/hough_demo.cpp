@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "hough_plane_detector/core/plane_detector.h"
-#include "hough_plane_detector/core/plane_metrics.h"
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/tools/cli_options.h"
 
 using namespace hough_plane_detector;

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/core/camera_intrinsics.h"
 
 namespace hough_plane_detector
 {

@@ -10,7 +10,7 @@
 
 #include <Eigen/Geometry>
 
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 namespace hough_plane_detector
 {

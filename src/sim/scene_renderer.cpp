@@ -1,4 +1,4 @@
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 #include "hough_plane_detector/core/sensor_model.h"
 

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "hough_plane_detector/core/camera_intrinsics.h"
 #include "hough_plane_detector/core/cloud_view.h"
 
 namespace hough_plane_detector
@@ -58,18 +59,6 @@ struct Scene
   // Distinct infinite planes of the rectangles (coplanar rectangles are one plane), and for
   // each rectangle the index of its plane.
   std::vector<TruePlane> truePlanes(std::vector<int>* rectangle_plane = nullptr) const;
-};
-
-struct CameraIntrinsics
-{
-  int width = 640;
-  int height = 480;
-  double fx = 580.0;
-  double fy = 580.0;
-  double cx = 319.5;
-  double cy = 239.5;
-  double min_range = 0.5;  // Kinect returns nothing nearer or farther
-  double max_range = 6.0;
 };
 
 struct KinectNoise

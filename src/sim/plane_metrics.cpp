@@ -1,4 +1,4 @@
-#include "hough_plane_detector/core/plane_metrics.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
 
 #include <algorithm>
 #include <cmath>

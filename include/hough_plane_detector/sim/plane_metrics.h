@@ -5,7 +5,7 @@
 
 #include <Eigen/Core>
 
-#include "hough_plane_detector/core/scene_renderer.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 
 namespace hough_plane_detector
 {
