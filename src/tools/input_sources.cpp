@@ -13,6 +13,8 @@
 #include <tf2/exceptions.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "hough_plane_detector/core/depth_image.h"
+
 namespace hough_plane_detector
 {
 
@@ -78,6 +80,20 @@ bool depthImageToCloud(const sensor_msgs::Image& image, const sensor_msgs::Camer
       image.data.size() < static_cast<size_t>(image.step) * image.height)
     return fail("depth image of " + std::to_string(image.width) + " x " + std::to_string(image.height) + ", step " +
                 std::to_string(image.step) + " holds " + std::to_string(image.data.size()) + " bytes: too few");
+  CameraIntrinsics k;
+  k.width = static_cast<int>(image.width);
+  k.height = static_cast<int>(image.height);
+  k.fx = fx;
+  k.fy = fy;
+  k.cx = cx;
+  k.cy = cy;
+  k.min_range = 0.0;  // the driver already dropped what its sensor does not measure
+  k.max_range = std::numeric_limits<double>::infinity();
+  std::vector<float> points;
+  if (millimetres)
+    depthImageToPoints(reinterpret_cast<const uint16_t*>(image.data.data()), k.width, k.height, image.step, k, 0.001, points);
+  else
+    depthImageToPoints(reinterpret_cast<const float*>(image.data.data()), k.width, k.height, image.step, k, points);
   cloud = sensor_msgs::PointCloud2();
   cloud.header = image.header;
   cloud.width = image.width;
@@ -95,36 +111,8 @@ bool depthImageToCloud(const sensor_msgs::Image& image, const sensor_msgs::Camer
     field.count = 1;
     cloud.fields.push_back(field);
   }
-  cloud.data.resize(static_cast<size_t>(cloud.row_step) * cloud.height);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (uint32_t v = 0; v < image.height; ++v)
-  {
-    const uint8_t* row = &image.data[static_cast<size_t>(v) * image.step];
-    for (uint32_t u = 0; u < image.width; ++u)
-    {
-      double z;
-      if (millimetres)
-      {
-        uint16_t mm;
-        std::memcpy(&mm, row + 2 * u, 2);
-        z = mm * 0.001;
-      }
-      else
-      {
-        float m;
-        std::memcpy(&m, row + 4 * u, 4);
-        z = m;
-      }
-      float xyz[3] = {nan, nan, nan};
-      if (std::isfinite(z) && z > 0.0)  // 0 or NaN: no return
-      {
-        xyz[0] = static_cast<float>((u - cx) / fx * z);
-        xyz[1] = static_cast<float>((v - cy) / fy * z);
-        xyz[2] = static_cast<float>(z);
-      }
-      std::memcpy(&cloud.data[(static_cast<size_t>(v) * image.width + u) * 12], xyz, 12);
-    }
-  }
+  cloud.data.resize(points.size() * sizeof(float));
+  std::memcpy(cloud.data.data(), points.data(), cloud.data.size());
   return true;
 }
 

@@ -1,4 +1,4 @@
-// Organized points from a depth image (OpenNI2 gives 16-bit millimetres per pixel).
+// Organized points from a depth image (16-bit millimetres as OpenNI2 gives them, or metres).
 #pragma once
 
 #include <cstddef>
@@ -14,6 +14,10 @@ namespace hough_plane_detector
 // row; NaN where the depth is 0 or outside [min_range, max_range]. row_stride in bytes.
 void depthImageToPoints(const uint16_t* depth, int width, int height, size_t row_stride,
                         const CameraIntrinsics& intrinsics, double metres_per_unit, std::vector<float>& points);
+
+// The same from depths in metres (32FC1), NaN or 0 for no return.
+void depthImageToPoints(const float* metres, int width, int height, size_t row_stride, const CameraIntrinsics& intrinsics,
+                        std::vector<float>& points);
 
 // Pinhole intrinsics of a sensor from its image size and fields of view (radians).
 CameraIntrinsics intrinsicsFromFieldOfView(int width, int height, double horizontal_fov, double vertical_fov);
