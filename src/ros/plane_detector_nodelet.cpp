@@ -24,6 +24,7 @@
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/SaveMap.h"
 #include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/ros/frame_id.h"
 #include "hough_plane_detector/ros/plane_markers.h"
 #include "hough_plane_detector/ros/point_cloud2_layout.h"
 
@@ -78,7 +79,7 @@ private:
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& private_nh = getPrivateNodeHandle();
     private_nh.param<std::string>("world_frame", world_frame_, "odom");
-    world_frame_ = tfFrame(world_frame_);
+    world_frame_ = tf2FrameId(world_frame_);
     private_nh.param("latch", latch_, true);  // a map server: late subscribers get the map
     int queue_size;
     private_nh.param("queue_size", queue_size, 2);
@@ -159,15 +160,9 @@ private:
                  subscriber_->getTopic().c_str(), world_frame_.c_str(), params_.resolution, std::max(1, concurrency_level));
   }
 
-  // tf2 frame ids have no leading '/'; tf1-era recordings (the TUM RGB-D bags) still send them.
-  static std::string tfFrame(const std::string& frame)
-  {
-    return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
-  }
-
   bool frameUnknown(const std::string& frame) const
   {
-    return !frame.empty() && tfFrame(frame) != world_frame_ && !tf_buffer_->_frameExists(tfFrame(frame));
+    return !frame.empty() && tf2FrameId(frame) != world_frame_ && !tf_buffer_->_frameExists(tf2FrameId(frame));
   }
 
   void checkFrameKnown(const sensor_msgs::PointCloud2ConstPtr& cloud)
@@ -229,7 +224,7 @@ private:
     try
     {
       camera_to_world = tf2::transformToEigen(
-          tf_buffer_->lookupTransform(world_frame_, tfFrame(cloud->header.frame_id), cloud->header.stamp));
+          tf_buffer_->lookupTransform(world_frame_, tf2FrameId(cloud->header.frame_id), cloud->header.stamp));
     }
     catch (const tf2::TransformException& e)
     {

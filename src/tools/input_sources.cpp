@@ -14,6 +14,7 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include "hough_plane_detector/core/depth_image.h"
+#include "hough_plane_detector/ros/frame_id.h"
 
 namespace hough_plane_detector
 {
@@ -48,14 +49,6 @@ bool loadPcd(const std::string& path, pcl::PCLPointCloud2& cloud, std::string* e
   }
   return true;
 }
-
-namespace
-{
-std::string withoutLeadingSlash(const std::string& frame)
-{
-  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
-}
-}  // namespace
 
 bool depthImageToCloud(const sensor_msgs::Image& image, const sensor_msgs::CameraInfo& info,
                        sensor_msgs::PointCloud2& cloud, std::string* error)
@@ -147,7 +140,7 @@ bool BagFrameSource::open(const std::string& path, const std::string& topic, con
     if (error) *error = path + ": not a readable rosbag (" + e.what() + ")";
     return false;
   }
-  impl_->world_frame = withoutLeadingSlash(world_frame);
+  impl_->world_frame = tf2FrameId(world_frame);
   impl_->topic = topic;
   try
   {
@@ -246,7 +239,7 @@ bool BagFrameSource::next(BagFrame& frame)
       frame.cloud = m.instantiate<sensor_msgs::PointCloud2>();
       if (!frame.cloud) continue;
     }
-    const std::string source = withoutLeadingSlash(frame.cloud->header.frame_id);
+    const std::string source = tf2FrameId(frame.cloud->header.frame_id);
     if (source.empty())
     {
       frame.skip_reason = "cloud has an empty frame_id";
