@@ -66,11 +66,5 @@ TEST(BagPlayback, NodeletOnAPlayedBagMatchesTheOfflineTool)
 
 int main(int argc, char** argv)
 {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_bag_playback");
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  return result;
+  return runRosTests(argc, argv, "test_bag_playback");
 }

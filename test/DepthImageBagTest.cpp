@@ -56,11 +56,5 @@ TEST(DepthImage, ATumStyleBagGivesTheRoomsPlanes)
 
 int main(int argc, char** argv)
 {
-  testing::InitGoogleTest(&argc, argv);
-  ros::init(argc, argv, "test_depth_image");
-  ros::AsyncSpinner spinner(1);
-  spinner.start();
-  const int result = RUN_ALL_TESTS();
-  spinner.stop();
-  return result;
+  return runRosTests(argc, argv, "test_depth_image");
 }

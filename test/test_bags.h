@@ -11,7 +11,9 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <ros/ros.h>
 #include <Eigen/Geometry>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -191,6 +193,18 @@ inline std::vector<TruePlane> writeTumBag(
   bag.write("/tf", ros::Time(last), tf);
   bag.close();
   return seen;
+}
+
+// main() of a rostest gtest that plays bags: gtest, a ROS node named `name`, one spinner thread.
+inline int runRosTests(int argc, char** argv, const char* name)
+{
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, name);
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  const int result = RUN_ALL_TESTS();
+  spinner.stop();
+  return result;
 }
 
 // Runs a shell command; its stdout and stderr, and its exit code (-1 when it did not exit).
