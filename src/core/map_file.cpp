@@ -1,4 +1,4 @@
-// Saving and loading the detector's persistent map.
+// Saving and loading the persistent map (PlaneMap), and the detector's file versions of it.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/core/plane_map.h"
 
 namespace hough_plane_detector
 {
@@ -66,7 +67,7 @@ private:
 };
 }  // namespace
 
-std::string PlaneDetector::withMapChecksum(const std::string& bytes)
+std::string PlaneMap::withChecksum(const std::string& bytes)
 {
   Writer w;
   w.bytes = bytes;
@@ -74,7 +75,7 @@ std::string PlaneDetector::withMapChecksum(const std::string& bytes)
   return w.bytes;
 }
 
-std::string PlaneDetector::serializeMap() const
+std::string PlaneMap::serialize() const
 {
   Writer w;
   w.putBytes(kMagic, sizeof(kMagic));
@@ -138,10 +139,10 @@ std::string PlaneDetector::serializeMap() const
     w.put(belief.confirmations);
     w.put(belief.contradictions);
   }
-  return withMapChecksum(w.bytes);
+  return withChecksum(w.bytes);
 }
 
-bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
+bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
 {
   auto fail = [error](const std::string& what) {
     if (error) *error = what;
@@ -264,9 +265,19 @@ bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
   beliefs_.swap(beliefs);
   next_id_ = next_id;
   frame_count_ = frame_count;
-  samples_.clear();
-  sample_labels_.clear();
-  block_labels_.clear();
+  return true;
+}
+
+std::string PlaneDetector::withMapChecksum(const std::string& bytes) { return PlaneMap::withChecksum(bytes); }
+
+std::string PlaneDetector::serializeMap() const { return map_.serialize(); }
+
+bool PlaneDetector::deserializeMap(const std::string& bytes, std::string* error)
+{
+  if (!map_.deserialize(bytes, error)) return false;
+  // The last frame's labels name planes of the old map.
+  frame_.samples.clear();
+  labels_ = FrameLabels();
   return true;
 }
 

@@ -1,0 +1,36 @@
+// The frame in progress as the per-frame stages see it: the normal estimator's windows and
+// blocks with their noise statistics, the camera pose, and which blocks a plane of this
+// frame has taken. PlaneDetector owns it and refreshes it every frame.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "hough_plane_detector/core/block_regions.h"
+#include "hough_plane_detector/core/normal_estimator.h"
+#include "hough_plane_detector/core/sensor_model.h"
+
+namespace hough_plane_detector
+{
+
+struct FrameData
+{
+  NormalEstimator normals;
+  std::vector<WindowSample> samples;  // planar windows (world frame)
+  std::vector<BlockInfo> blocks;      // per block of normals' grid, camera frame
+  DepthNoiseModel noise;              // the sensor's, for this frame
+  Eigen::Isometry3d camera_to_world = Eigen::Isometry3d::Identity();
+  std::vector<char> block_claim;  // blocks taken by an earlier plane of this frame
+
+  int blocksX() const { return normals.blocksX(); }
+  int blocksY() const { return normals.blocksY(); }
+  const PointMoments& moments(int block) const { return normals.block(block % blocksX(), block / blocksX()); }
+  double points(int block) const { return moments(block).count; }
+  // A world plane (normal, d) in the camera frame, where the blocks are.
+  Eigen::Vector3d normalInCamera(const Eigen::Vector3d& normal) const { return camera_to_world.linear().transpose() * normal; }
+  double dInCamera(const Eigen::Vector3d& normal, double d) const { return d + normal.dot(camera_to_world.translation()); }
+};
+
+}  // namespace hough_plane_detector

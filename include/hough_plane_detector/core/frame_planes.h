@@ -1,0 +1,90 @@
+// Per-frame planes (paper 3.5): each local Hough peak is fitted to the frame's points that
+// agree with it, by the paper's windows or by block regions grown from it, and kept when
+// the planarity tests pass; a plane a few degrees off a known one may take its normal.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "hough_plane_detector/core/detected_plane.h"
+#include "hough_plane_detector/core/detector_params.h"
+#include "hough_plane_detector/core/frame_data.h"
+#include "hough_plane_detector/core/hough_parameterization.h"
+#include "hough_plane_detector/core/hough_peaks.h"
+#include "hough_plane_detector/core/planarity_tests.h"
+
+namespace hough_plane_detector
+{
+
+// What became of a local Hough peak of the last frame: why a plane in view was not detected.
+enum class CandidateVerdict
+{
+  kAccepted,           // a per-frame plane, voted into the map
+  kTooFewPoints,       // fewer than min_support points lie on it (windows, then blocks)
+  kCurvedPatches,      // its connected patches are curved (halves tilt apart) or tiny
+  kCentroidsOffPlane,  // block centroids scatter more than the sensor noise allows (chi^2)
+  kHalvesDisagree,     // the fits of its two halves differ by more than merge_angle
+  kNotParallel,        // parallel search: its blocks' own fit is not parallel to the known plane
+  kEdgeOn,             // region: most rays graze its plane, which their depths cannot test
+};
+const char* toString(CandidateVerdict verdict);
+
+struct PlaneCandidate
+{
+  Eigen::Vector3d normal;  // world frame, after the last refit
+  double d;
+  double peak_value;       // blurred local Hough value of its peak; 0 for the parallel search
+  double points;           // points on it when it was accepted or refused (0: too few windows)
+  CandidateVerdict verdict;
+  bool parallel_search = false;  // a cluster of the parallel search, not a Hough peak
+};
+
+// An accepted plane of the frame, world frame.
+struct FramePlane
+{
+  Eigen::Vector3d hough = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double d = 0.0;
+  double value = 0.0;     // its local peak's value; 0 for the parallel search and leftover regions
+  double support = 0.0;   // points of the frame on it
+  bool parallel = false;  // with a known plane's normal: the parallel search's, or snapped to it
+  std::vector<int> blocks;  // region_growing: the blocks of its region
+};
+
+class FramePlaneFitter
+{
+public:
+  FramePlaneFitter(const DetectorParams& params, const HoughParameterization& param, FrameData& frame,
+                   const PlanarityTests& tests);
+
+  // The paper's fit, strongest peak first: each peak takes the windows that agree with it and
+  // no earlier plane took and their blocks, refitted until they no longer change. A plane may snap
+  // to the normal of one of `map_planes`. Fills frame.block_claim.
+  void fitWindows(const std::vector<HoughPeak>& peaks, const std::vector<DetectedPlane>& map_planes,
+                  std::vector<FramePlane>& planes, std::vector<PlaneCandidate>& candidates);
+  // region_growing: each peak seeds block regions grown on their refitted planes; then the
+  // flat blocks left seed regions of their own.
+  void growRegions(const std::vector<HoughPeak>& peaks, const std::vector<DetectedPlane>& map_planes,
+                   std::vector<FramePlane>& planes, std::vector<PlaneCandidate>& candidates);
+  // Camera-frame moments of the blocks under `windows` (indices into frame.samples) that lie
+  // on the world plane (normal, d) and no plane of this frame claimed. `tight` (around a
+  // fitted plane) also drops blocks farther off than their own noise allows.
+  PointMoments collectPlaneBlocks(const Eigen::Vector3d& normal, double d, const std::vector<int>& windows,
+                                  std::vector<int>& blocks, bool tight = false);
+  // Gives an accepted plane within snap_angle of a known plane (the map's, or this frame's in
+  // `planes`) that normal, and the offset its blocks agree on, when most of its points lie
+  // on that parallel plane within their noise and the likelihood-ratio test allows. True if it did.
+  bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
+                            const std::vector<DetectedPlane>& map_planes, const std::vector<FramePlane>& planes) const;
+
+private:
+  const DetectorParams& params_;
+  const HoughParameterization& param_;
+  FrameData& frame_;
+  const PlanarityTests& tests_;
+  std::vector<int> block_mark_;  // scratch of collectPlaneBlocks
+  int mark_generation_ = 0;
+};
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,58 @@
+// Statistical tests of a set of the frame's blocks against a plane, each against the noise
+// the sensor has at the blocks' depths: do the centroids lie on one plane, do its halves
+// agree, does a given normal explain them as well as their own fit.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "hough_plane_detector/core/detector_params.h"
+#include "hough_plane_detector/core/frame_data.h"
+
+namespace hough_plane_detector
+{
+
+constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
+constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
+constexpr double kMaxSnapChi2Increase = 9.21;      // a known normal's fit: chi^2 with 2 dof, p = 0.01
+
+class PlanarityTests
+{
+public:
+  PlanarityTests(const DetectorParams& params, const FrameData& frame);
+
+  // True when the block centroids of a fitted plane scatter no more than the sensor's noise.
+  bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;
+  // True when the fits of the two halves of blocks[begin, end) agree within max_angle (and,
+  // for block regions, within what the halves' noise explains).
+  bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const;
+  // Drops the connected patches of `blocks` that are tiny, narrower than min_span blocks
+  // across the image, whose halves tilt apart by more than max_angle (curved) or that fail
+  // `also`; moments of the rest.
+  PointMoments keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
+                                  const std::function<bool(const std::vector<int>&)>& also = nullptr) const;
+  // True when a plane of the camera-frame normal explains the blocks (their interior when it
+  // has kMinInteriorBlocks: rim blocks may straddle a fold) about as well as their own best
+  // plane: a likelihood-ratio test, chi^2 increase below kMaxSnapChi2Increase.
+  bool explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
+  // How much more chi^2 the block centroids have about their best plane of the camera-frame
+  // normal than about their own best plane (both with the centroids' noise).
+  double snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
+  // Mean chi^2 of the block centroids about a camera-frame plane.
+  double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
+  // True when the blocks' own fit is within 2 merge_angle of the camera-frame normal.
+  bool fitIsParallel(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
+  // Moments of the blocks' centroids, each weighted by the inverse variance of the sensor at its depth.
+  PointMoments weightedMoments(const std::vector<int>& blocks) const;
+
+private:
+  const DetectorParams& params_;
+  const FrameData& frame_;
+  mutable std::vector<int> member_mark_;  // scratch of keepFlatComponents
+  mutable std::vector<int> visit_mark_;
+  mutable int generation_ = 0;
+};
+
+}  // namespace hough_plane_detector

@@ -1,0 +1,91 @@
+// The persistent map (paper 3.6-3.7, Alg. 2): the global Hough space every frame's planes
+// vote into, its thinning, its peaks as planes with stable ids, where each plane has been
+// seen (extents) and, when forgetting by evidence, how far the frames confirm it. Map files
+// serialise exactly this.
+#pragma once
+
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "hough_plane_detector/core/cloud_view.h"
+#include "hough_plane_detector/core/detected_plane.h"
+#include "hough_plane_detector/core/detector_params.h"
+#include "hough_plane_detector/core/frame_data.h"
+#include "hough_plane_detector/core/frame_planes.h"
+#include "hough_plane_detector/core/hough_peaks.h"
+#include "hough_plane_detector/core/hough_voting.h"
+#include "hough_plane_detector/core/plane_evidence.h"
+#include "hough_plane_detector/core/plane_extent.h"
+#include "hough_plane_detector/core/sparse_hough_space.h"
+
+namespace hough_plane_detector
+{
+
+class PlaneMap
+{
+public:
+  // `params` is read at every call (reconfigure changes it in place); the grid, the voting's
+  // kernel and the peak search are the detector's.
+  PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
+           const HoughPeakSearch& peak_search);
+
+  // Counts the frame (extents and evidence age by frames).
+  void beginFrame() { ++frame_count_; }
+  // Forgetting by evidence: each plane's belief from this frame's depths over its extent.
+  void checkEvidence(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
+                     const PinholeIntrinsics& intrinsics, const DepthNoiseModel& noise);
+  // Alg. 2: thins the space, adds one Gaussian per frame plane (up to 2 for a strong plane not
+  // yet in the map), caps the chunks, and makes the space's peaks the map's planes, each
+  // keeping the id of the previous plane it continues. Returns the chunks the cap evicted.
+  int accumulate(const std::vector<FramePlane>& frame_planes, const Eigen::Vector3d& camera_position, double stamp);
+  // This frame's measured support of each plane (index of planes()) and its labelled blocks
+  // (plane ids over frame's block grid): sets support and last_seen and grows the extents.
+  void observe(const std::vector<int>& support, const std::vector<int>& block_labels, const FrameData& frame,
+               double stamp);
+
+  const std::vector<DetectedPlane>& planes() const { return planes_; }
+  const SparseHoughSpace& space() const { return global_; }
+  size_t chunksEvictedTotal() const { return chunks_evicted_total_; }
+  // Where the plane has been seen (nullptr for an unknown id).
+  const PlaneExtent* extent(int id) const;
+  std::vector<Eigen::Vector3d> hull(const DetectedPlane& plane) const;
+  std::vector<std::vector<Eigen::Vector3d>> regions(const DetectedPlane& plane) const;
+  void clear();
+
+  // Versioned bytes with the grid they were built on and a checksum (map_file.cpp).
+  std::string serialize() const;
+  // Replaces the state; on any problem returns false with `error` set and changes nothing.
+  bool deserialize(const std::string& bytes, std::string* error);
+  static std::string withChecksum(const std::string& bytes);
+
+private:
+  // Thinning (3.7); by evidence, the cells of established planes are spared and gone planes' cleared.
+  void thin(float cap);
+  void thinByEvidence(float cap);
+  // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map.
+  float voteWeight(const FramePlane& plane) const;
+  // The space's peaks as the new plane list, ids carried over from the closest previous plane.
+  void matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp);
+  // Beliefs follow the ids: new planes start afresh, planes that left the map take theirs along.
+  void carryBeliefs();
+  // How fast extents fade per frame: with thinning as the Hough space does, by evidence never.
+  float extentFade() const;
+
+  const DetectorParams& params_;
+  const HoughParameterization& param_;
+  const HoughVoting& voting_;
+  const HoughPeakSearch& peak_search_;
+  SparseHoughSpace global_;
+  std::vector<DetectedPlane> planes_;
+  std::unordered_map<int, PlaneExtent> extents_;
+  std::unordered_map<int, PlaneBelief> beliefs_;  // forgetting by evidence, by plane id
+  int64_t frame_count_ = 0;          // frames since the map began (extents fade by it)
+  size_t chunks_evicted_total_ = 0;  // chunks freed by the max_chunks cap since the map began
+  int next_id_ = 0;
+};
+
+}  // namespace hough_plane_detector

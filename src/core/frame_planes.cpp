@@ -1,0 +1,309 @@
+#include "hough_plane_detector/core/frame_planes.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "hough_plane_detector/core/plane_geometry.h"
+
+namespace hough_plane_detector
+{
+
+namespace
+{
+constexpr double kMinSnapInlierShare = 0.8;  // snapping: points that must lie on the parallel plane
+}  // namespace
+
+const char* toString(CandidateVerdict verdict)
+{
+  switch (verdict)
+  {
+    case CandidateVerdict::kAccepted: return "accepted";
+    case CandidateVerdict::kTooFewPoints: return "too few points";
+    case CandidateVerdict::kCurvedPatches: return "curved patches";
+    case CandidateVerdict::kCentroidsOffPlane: return "centroids off the plane";
+    case CandidateVerdict::kHalvesDisagree: return "halves disagree";
+    case CandidateVerdict::kNotParallel: return "not parallel to the known plane";
+    case CandidateVerdict::kEdgeOn: return "seen edge-on";
+  }
+  return "unknown";
+}
+
+FramePlaneFitter::FramePlaneFitter(const DetectorParams& params, const HoughParameterization& param, FrameData& frame,
+                                   const PlanarityTests& tests)
+  : params_(params), param_(param), frame_(frame), tests_(tests)
+{
+}
+
+PointMoments FramePlaneFitter::collectPlaneBlocks(const Eigen::Vector3d& normal, double d,
+                                                 const std::vector<int>& windows, std::vector<int>& blocks,
+                                                 bool tight)
+{
+  // Blocks covered by the windows, each once, whose points lie on the plane.
+  const int k = params_.normal_window / blockSize(params_.normal_window, params_.normal_stride);
+  const int bx_count = frame_.normals.blocksX();
+  block_mark_.resize(static_cast<size_t>(bx_count) * frame_.normals.blocksY(), 0);
+  ++mark_generation_;
+  // The plane in the camera frame, to test block centroids without transforming blocks.
+  const Eigen::Vector3d n_cam = frame_.camera_to_world.linear().transpose() * normal;
+  const double d_cam = d + normal.dot(frame_.camera_to_world.translation());
+  PointMoments moments;
+  blocks.clear();
+  for (int s : windows)
+    for (int by = frame_.samples[s].window_y; by < frame_.samples[s].window_y + k; ++by)
+      for (int bx = frame_.samples[s].window_x; bx < frame_.samples[s].window_x + k; ++bx)
+      {
+        const int b = by * bx_count + bx;
+        if (block_mark_[b] == mark_generation_) continue;
+        block_mark_[b] = mark_generation_;
+        const BlockInfo& info = frame_.blocks[b];
+        if (!info.valid || (!frame_.block_claim.empty() && frame_.block_claim[b])) continue;
+        const double residual = std::abs(n_cam.dot(info.centroid) + d_cam);
+        // Tight: drops surfaces that merely cross the infinite plane along a line.
+        if (residual > (tight ? std::min(params_.support_distance, info.tight_residual) : params_.support_distance))
+          continue;
+        // A block straddling an edge keeps its centroid near the plane while a few far points
+        // would dominate the fit's moments: its spread along the normal must look like noise.
+        if (n_cam.dot(info.covariance * n_cam) > info.thickness_limit) continue;
+        moments.add(frame_.normals.block(bx, by));
+        blocks.push_back(b);
+      }
+  return moments;
+}
+
+void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std::vector<DetectedPlane>& map_planes,
+                                  std::vector<FramePlane>& planes, std::vector<PlaneCandidate>& candidates)
+{
+  // Greedy, strongest first: a peak takes the windows that agree with it and no earlier
+  // plane took, is refined by a least-squares fit to their points, and keeps them. Weaker
+  // echoes of the same plane find nothing left; refined per-frame planes that agree to a
+  // fraction of a cell keep the global peaks sharp.
+  std::vector<char> claimed(frame_.samples.size(), 0);
+  const double overlap = static_cast<double>(params_.normal_stride * params_.normal_stride) /
+                         (params_.normal_window * params_.normal_window);
+  frame_.block_claim.assign(static_cast<size_t>(frame_.normals.blocksX()) * frame_.normals.blocksY(), 0);
+  const double cos_limit = std::cos(params_.support_angle);
+  std::vector<int> windows, blocks;
+  for (const HoughPeak& peak : peaks)
+  {
+    Eigen::Vector3d normal = peak.normal;
+    double d = peak.d;
+    PointMoments moments, weighted;  // weighted: of the final blocks, reused by the planarity test
+    CandidateVerdict verdict = CandidateVerdict::kAccepted;
+    for (int pass = 0; pass < 3; ++pass)
+    {
+      windows.clear();
+      double window_points = 0.0;
+      for (size_t s = 0; s < frame_.samples.size(); ++s)
+      {
+        if (claimed[s] || std::abs(frame_.samples[s].normal.dot(normal)) < cos_limit) continue;
+        if (std::abs(normal.dot(frame_.samples[s].centroid) + d) <= params_.support_distance)
+        {
+          windows.push_back(static_cast<int>(s));
+          window_points += frame_.samples[s].count * overlap;
+        }
+      }
+      // Overlapping windows count their points about once each: too few, no fit needed.
+      if (window_points < params_.min_support)
+      {
+        moments = PointMoments();
+        verdict = CandidateVerdict::kTooFewPoints;
+        break;
+      }
+      moments = collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
+      if (moments.count < std::max(3, params_.min_support))
+      {
+        verdict = CandidateVerdict::kTooFewPoints;
+        break;
+      }
+      moments = tests_.keepFlatComponents(blocks, params_.merge_angle, 1);
+      if (moments.count < std::max(3, params_.min_support))
+      {
+        verdict = CandidateVerdict::kCurvedPatches;
+        break;
+      }
+      weighted = tests_.weightedMoments(blocks);
+      const PointMoments world = weighted.transformed(frame_.camera_to_world);
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+      solver.computeDirect(world.covariance());
+      Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
+      if (n.dot(normal) < 0.0) n = -n;
+      const double d_new = -n.dot(world.mean());
+      // Converged: another pass would select the same windows and blocks.
+      const bool converged = pass > 0 && unsignedAngle(n, normal) < 2e-4 && std::abs(d_new - d) < 5e-4;
+      normal = n;
+      d = d_new;
+      if (converged) break;
+    }
+    if (verdict == CandidateVerdict::kAccepted && !tests_.isPlanarFit(weighted, blocks))
+      verdict = CandidateVerdict::kCentroidsOffPlane;
+    else if (verdict == CandidateVerdict::kAccepted && !tests_.halvesAgree(blocks, 0, blocks.size(), params_.merge_angle))
+      verdict = CandidateVerdict::kHalvesDisagree;
+    const bool snapped = verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, blocks, map_planes, planes);
+    candidates.push_back({normal, d, peak.value, moments.count, verdict});
+    if (verdict != CandidateVerdict::kAccepted) continue;
+    // Claim everything within support_distance, not just the tight fit, so that leftovers
+    // around an accepted plane cannot pose as a slightly tilted second one.
+    for (int s : windows) claimed[s] = 1;
+    for (int b : blocks) frame_.block_claim[b] = 1;
+    collectPlaneBlocks(normal, d, windows, blocks, false);
+    for (int b : blocks) frame_.block_claim[b] = 1;
+    FramePlane refined;
+    refined.normal = normal;
+    refined.d = d;
+    refined.hough = param_.toHough(normal, d);
+    refined.value = peak.value;
+    refined.support = moments.count;
+    refined.parallel = snapped;
+    planes.push_back(refined);
+  }
+}
+
+void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const std::vector<DetectedPlane>& map_planes,
+                                   std::vector<FramePlane>& planes, std::vector<PlaneCandidate>& candidates)
+{
+  // Strongest first, each peak seeds regions of blocks that agree with it; each region grows
+  // over the neighbouring blocks that lie on its refitted plane within their noise and is
+  // kept when it is a plane by the same statistics. Blocks a kept region took are taken for
+  // the weaker peaks. Then every flat block left seeds a region of its own plane: faces too
+  // small for a window's vote (box sides, far shelves) are still planes of the frame.
+  frame_.block_claim.assign(frame_.blocks.size(), 0);
+  std::vector<char> tried(frame_.blocks.size(), 0);
+  BlockRegionGrower grower(frame_.normals, frame_.blocks, params_);
+  const Eigen::Matrix3d world_to_camera = frame_.camera_to_world.linear().transpose();
+  auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
+    PlaneRegion region = grower.grow(seed, n_cam, d_cam, frame_.block_claim);
+    for (int b : region.blocks) tried[b] = 1;
+    for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
+    CandidateVerdict verdict = CandidateVerdict::kAccepted;
+    PointMoments moments;
+    if (region.points < std::max(3, params_.min_support))
+      verdict = CandidateVerdict::kTooFewPoints;
+    else if ((moments = tests_.keepFlatComponents(region.blocks, params_.merge_angle, 1)).count < std::max(3, params_.min_support))
+      verdict = CandidateVerdict::kCurvedPatches;
+    else if (!grower.fit(region.blocks, region.normal, region.d))  // of the flat components kept
+      verdict = CandidateVerdict::kTooFewPoints;
+    else if (grower.seenEdgeOn(region.blocks, region.normal))
+      verdict = CandidateVerdict::kEdgeOn;
+    else if (grower.normalsTurn(region.blocks, region.normal))
+      verdict = CandidateVerdict::kCurvedPatches;
+    else if (grower.centroidsBend(region.blocks, region.normal, region.d))
+      verdict = CandidateVerdict::kCurvedPatches;
+    else if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
+      verdict = CandidateVerdict::kCentroidsOffPlane;
+    else if (!tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
+      verdict = CandidateVerdict::kHalvesDisagree;
+    Eigen::Vector3d normal = frame_.camera_to_world.linear() * region.normal;
+    double d = region.d - normal.dot(frame_.camera_to_world.translation());
+    const bool snapped = verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, map_planes, planes);
+    candidates.push_back({normal, d, peak_value, std::max(region.points, moments.count), verdict});
+    if (verdict != CandidateVerdict::kAccepted) return;
+    for (int b : region.blocks) frame_.block_claim[b] = 1;
+    FramePlane refined;
+    refined.normal = normal;
+    refined.d = d;
+    refined.hough = param_.toHough(normal, d);
+    refined.value = peak_value;
+    refined.support = moments.count;
+    refined.parallel = snapped;
+    refined.blocks = region.blocks;
+    planes.push_back(refined);
+  };
+  constexpr size_t kMinSeedBlocks = 2;
+  for (const HoughPeak& peak : peaks)
+  {
+    const Eigen::Vector3d n_cam = world_to_camera * peak.normal;
+    const double d_cam = peak.d + peak.normal.dot(frame_.camera_to_world.translation());
+    for (const std::vector<int>& seed : grower.seedComponents(n_cam, d_cam, frame_.block_claim))
+    {
+      if (seed.size() < kMinSeedBlocks) break;
+      bool fresh = false;
+      for (int b : seed) fresh |= !frame_.block_claim[b] && !tried[b];
+      if (fresh) consider(seed, n_cam, d_cam, peak.value);
+    }
+  }
+  // Leftover flat blocks, most points first, each with its own plane as the first guess.
+  std::vector<int> order;
+  for (size_t b = 0; b < frame_.blocks.size(); ++b)
+    if (frame_.blocks[b].planar && !frame_.block_claim[b] && !tried[b]) order.push_back(static_cast<int>(b));
+  const int bx_count = frame_.normals.blocksX();
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return frame_.normals.block(a % bx_count, a / bx_count).count > frame_.normals.block(b % bx_count, b / bx_count).count;
+  });
+  for (int b : order)
+  {
+    if (frame_.block_claim[b] || tried[b]) continue;
+    const BlockInfo& info = frame_.blocks[b];
+    consider({b}, info.normal, -info.normal.dot(info.centroid), 0.0);
+  }
+}
+
+bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
+                                            const std::vector<DetectedPlane>& map_planes,
+                                            const std::vector<FramePlane>& planes) const
+{
+  // A small or far plane nearly parallel to a known one (a stair tread to the floor, a shelf
+  // top) is fitted with a tilt of a few degrees: blocks of the surfaces it meets lean on its
+  // edges. If most of its points lie on a plane of the known normal within their noise, that
+  // plane, with one parameter fewer, is the better model.
+  const Eigen::Vector3d* closest = nullptr;
+  double closest_angle = params_.snap_angle;
+  auto consider = [&](const Eigen::Vector3d& known_normal) {  // an element of map_planes or planes
+    const double angle = unsignedAngle(known_normal, normal);
+    if (angle < closest_angle)
+    {
+      closest_angle = angle;
+      closest = &known_normal;
+    }
+  };
+  for (const DetectedPlane& plane : map_planes) consider(plane.normal);
+  for (const FramePlane& plane : planes) consider(plane.normal);
+  if (!closest || blocks.empty()) return false;
+  const Eigen::Vector3d known = closest->dot(normal) >= 0.0 ? *closest : Eigen::Vector3d(-*closest);
+  const Eigen::Vector3d n_cam = frame_.camera_to_world.linear().transpose() * known;
+  // The offset most points agree on (a median: the leaning blocks are outliers), then the
+  // blocks within three of their sigmas of it.
+  const int bx_count = frame_.normals.blocksX();
+  auto points = [&](int b) { return frame_.normals.block(b % bx_count, b / bx_count).count; };
+  std::vector<std::pair<double, double>> offsets;  // camera-frame d of each block, its points
+  double total = 0.0;
+  for (int b : blocks)
+  {
+    offsets.emplace_back(-n_cam.dot(frame_.blocks[b].centroid), points(b));
+    total += points(b);
+  }
+  std::sort(offsets.begin(), offsets.end());
+  double median = offsets.back().first, below = 0.0;
+  for (const auto& offset : offsets)
+    if ((below += offset.second) >= 0.5 * total)
+    {
+      median = offset.first;
+      break;
+    }
+  std::vector<int> inliers;
+  double inlier_points = 0.0, weight_sum = 0.0, weighted_d = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = frame_.blocks[b];
+    const double offset = -n_cam.dot(info.centroid);
+    if (std::abs(offset - median) > 3.0 * std::sqrt(info.centroid_variance + kCentroidFloor)) continue;
+    inliers.push_back(b);
+    inlier_points += points(b);
+    weight_sum += info.fit_weight;
+    weighted_d += info.fit_weight * offset;
+  }
+  if (inlier_points < kMinSnapInlierShare * total) return false;
+  const double d_cam = weighted_d / weight_sum;
+  if (tests_.centroidChi2(n_cam, d_cam, inliers) > kMaxMeanCentroidChi2) return false;
+  // The known normal must also explain the inliers about as well as their own best plane: a
+  // likelihood-ratio test (2 degrees of freedom, the normal's), else a box face a few degrees
+  // off an older box's would take its direction. Judged on the interior: rim blocks straddling
+  // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
+  if (!tests_.explainedByNormal(n_cam, inliers)) return false;
+  normal = known;
+  d = d_cam - known.dot(frame_.camera_to_world.translation());
+  return true;
+}
+
+}  // namespace hough_plane_detector

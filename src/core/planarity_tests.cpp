@@ -1,0 +1,188 @@
+#include "hough_plane_detector/core/planarity_tests.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "hough_plane_detector/core/plane_geometry.h"
+
+namespace hough_plane_detector
+{
+
+PlanarityTests::PlanarityTests(const DetectorParams& params, const FrameData& frame) : params_(params), frame_(frame) {}
+
+bool PlanarityTests::isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const
+{
+  // A curved surface (a pillar, a ball) yields planar windows and even a whole fit within the
+  // sensor noise; but block centroids, where noise averages out, bend away from the fit.
+  // Each must lie on it as closely as the block's own scatter allows (chi^2 per block).
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(moments.covariance());
+  const Eigen::Vector3d normal = solver.eigenvectors().col(0);
+  const Eigen::Vector3d mean = moments.mean();
+  const int bx_count = frame_.normals.blocksX();
+  double chi2 = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = frame_.blocks[b];
+    const double count = frame_.normals.block(b % bx_count, b / bx_count).count;
+    // The block's own scatter along the plane normal: noise if it lies on the plane.
+    const double own_variance = std::max(0.0, normal.dot(info.covariance * normal));
+    const double step = frame_.noise.quantizationStep(info.centroid.z());
+    const double distance = normal.dot(info.centroid - mean);
+    chi2 += distance * distance / (own_variance / count + step * step / 12.0 + kCentroidFloor);
+  }
+  if (!blocks.empty() && chi2 / blocks.size() > kMaxMeanCentroidChi2) return false;
+  return true;
+}
+
+
+bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const
+{
+  // A curved strip fits a plane within the noise, but its two halves tilt apart.
+  const int bx_count = frame_.normals.blocksX();
+  PointMoments all;
+  for (size_t i = begin; i < end; ++i) all.add(centroidMoments(frame_.normals.block(blocks[i] % bx_count, blocks[i] / bx_count)));
+  if (all.count < 3) return true;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(all.covariance());
+  const Eigen::Vector3d mean = all.mean();
+  for (int axis = 1; axis <= 2; ++axis)
+  {
+    const Eigen::Vector3d direction = solver.eigenvectors().col(axis);
+    PointMoments halves[2];
+    double half_variance[2] = {0.0, 0.0};  // mean centroid variance of each half's blocks
+    int half_blocks[2] = {0, 0};
+    for (size_t i = begin; i < end; ++i)
+    {
+      const PointMoments block = centroidMoments(frame_.normals.block(blocks[i] % bx_count, blocks[i] / bx_count));
+      const int h = direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0;
+      halves[h].add(block);
+      half_variance[h] += frame_.blocks[blocks[i]].centroid_variance + kCentroidFloor;
+      ++half_blocks[h];
+    }
+    for (int h = 0; h < 2; ++h)
+      if (half_blocks[h] > 0) half_variance[h] /= half_blocks[h];
+    if (halves[0].count < 3 || halves[1].count < 3) continue;
+    Eigen::Vector3d half_normals[2];
+    double tilt_variance = 0.0;  // of the angle between the halves' normals, from their fits
+    for (int h = 0; h < 2; ++h)
+    {
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> half_solver;
+      half_solver.computeDirect(halves[h].covariance());
+      half_normals[h] = half_solver.eigenvectors().col(0);
+      // A fit of n centroids of noise v spread s^2 along its narrower side tilts by about
+      // sqrt(v / (n s^2)); two or three blocks in a row fix no normal at all.
+      const double spread = half_solver.eigenvalues()(1);
+      tilt_variance += spread > 0.0 ? half_variance[h] / (half_blocks[h] * spread) : 1e9;
+    }
+    const double tilt = unsignedAngle(half_normals[0], half_normals[1]);
+    // Windows' fit: the paper's fixed tolerance; regions: also beyond what the fits' noise explains.
+    if (tilt > max_angle && (!params_.region_growing || tilt > 3.0 * std::sqrt(tilt_variance))) return false;
+  }
+  return true;
+}
+
+PointMoments PlanarityTests::weightedMoments(const std::vector<int>& blocks) const
+{
+  return weightedCentroidMoments(frame_.blocks, blocks);
+}
+
+PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
+                                               const std::function<bool(const std::vector<int>&)>& also) const
+{
+  // Two pillars can share a tangent plane: each connected patch of the support must be flat
+  // on its own; curved patches are dropped, tiny ones too (they cannot be tested).
+  constexpr size_t kMinComponentBlocks = 4;
+  const int bx_count = frame_.normals.blocksX(), by_count = frame_.normals.blocksY();
+  member_mark_.resize(static_cast<size_t>(bx_count) * by_count, 0);
+  visit_mark_.resize(member_mark_.size(), 0);
+  ++generation_;
+  for (int b : blocks) member_mark_[b] = generation_;
+  std::vector<int> kept, component;
+  for (int seed : blocks)
+  {
+    if (visit_mark_[seed] == generation_) continue;
+    component.assign(1, seed);
+    visit_mark_[seed] = generation_;
+    for (size_t head = 0; head < component.size(); ++head)
+      forEachNeighbour(component[head], bx_count, by_count, [&](int nb) {
+        if (member_mark_[nb] != generation_ || visit_mark_[nb] == generation_) return;
+        visit_mark_[nb] = generation_;
+        component.push_back(nb);
+      });
+    int x_min = bx_count, x_max = -1, y_min = by_count, y_max = -1;
+    for (int b : component)
+    {
+      x_min = std::min(x_min, b % bx_count), x_max = std::max(x_max, b % bx_count);
+      y_min = std::min(y_min, b / bx_count), y_max = std::max(y_max, b / bx_count);
+    }
+    const bool wide_enough = x_max - x_min + 1 >= min_span && y_max - y_min + 1 >= min_span;
+    if (component.size() >= kMinComponentBlocks && wide_enough && halvesAgree(component, 0, component.size(), max_angle) &&
+        (!also || also(component)))
+      kept.insert(kept.end(), component.begin(), component.end());
+  }
+  blocks.swap(kept);
+  PointMoments moments;
+  for (int b : blocks) moments.add(frame_.normals.block(b % bx_count, b / bx_count));
+  return moments;
+}
+
+bool PlanarityTests::explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+{
+  std::vector<int> interior = interiorBlocks(blocks, frame_.normals.blocksX(), frame_.normals.blocksY());
+  if (interior.size() < kMinInteriorBlocks) interior = blocks;
+  return snapChi2Increase(n_cam, interior) <= kMaxSnapChi2Increase;
+}
+
+double PlanarityTests::snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+{
+  // Centroids weighted by their inverse variance: the smallest eigenvalue of their scatter
+  // times the total weight is the chi^2 of the best free plane; the fixed normal's best plane
+  // has the weighted variance of the offsets along it.
+  const int bx_count = frame_.normals.blocksX();
+  PointMoments sum;
+  double weight_sum = 0.0, offset_sum = 0.0, offset_squares = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = frame_.blocks[b];
+    const double weight = 1.0 / (info.centroid_variance + kCentroidFloor);
+    PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
+    m.scale(weight / m.count);
+    sum.add(m);
+    const double offset = n_cam.dot(info.centroid);
+    weight_sum += weight;
+    offset_sum += weight * offset;
+    offset_squares += weight * offset * offset;
+  }
+  if (weight_sum <= 0.0) return 0.0;
+  const double fixed_chi2 = offset_squares - offset_sum * offset_sum / weight_sum;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(sum.covariance());
+  return fixed_chi2 - std::max(0.0, solver.eigenvalues()(0)) * sum.count;
+}
+
+double PlanarityTests::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const
+{
+  double chi2 = 0.0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = frame_.blocks[b];
+    const double distance = n_cam.dot(info.centroid) + d_cam;
+    chi2 += distance * distance / (info.centroid_variance + kCentroidFloor);
+  }
+  return blocks.empty() ? 0.0 : chi2 / blocks.size();
+}
+
+bool PlanarityTests::fitIsParallel(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+{
+  // Far from a Kinect an 8 x 8 block is as thick as it is wide, so a band of wall blocks at one
+  // height passes for a floor-parallel patch block by block; their centroids together still
+  // span the wall, not a floor.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(weightedMoments(blocks).covariance());
+  return unsignedAngle(solver.eigenvectors().col(0), n_cam) <= 2.0 * params_.merge_angle;
+}
+
+}  // namespace hough_plane_detector

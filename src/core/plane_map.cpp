@@ -1,0 +1,269 @@
+#include "hough_plane_detector/core/plane_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "hough_plane_detector/core/plane_geometry.h"
+
+namespace hough_plane_detector
+{
+
+PlaneMap::PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
+                   const HoughPeakSearch& peak_search)
+  : params_(params)
+  , param_(param)
+  , voting_(voting)
+  , peak_search_(peak_search)
+  , global_(param.sizeAngle(), param.sizeAngle(), param.sizeD())
+{
+}
+
+void PlaneMap::clear()
+{
+  chunks_evicted_total_ = 0;
+  extents_.clear();
+  beliefs_.clear();
+  frame_count_ = 0;
+  global_.clear();
+  planes_.clear();
+  next_id_ = 0;
+}
+
+void PlaneMap::checkEvidence(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
+                             const PinholeIntrinsics& intrinsics, const DepthNoiseModel& noise)
+{
+  for (const DetectedPlane& plane : planes_)
+  {
+    const auto extent = extents_.find(plane.id);
+    if (extent == extents_.end()) continue;
+    const PlaneEvidence evidence = checkPlaneEvidence(extent->second, plane.normal, plane.d, cloud, camera_to_world,
+                                                      intrinsics, noise, frame_count_, extentFade());
+    beliefs_[plane.id].update(evidence);
+  }
+}
+
+int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eigen::Vector3d& camera_position,
+                         double stamp)
+{
+  const float cap = static_cast<float>(params_.permanence_cap);
+  // Thinning first, so a plane seen in this frame ends the frame at least 1 higher.
+  thin(cap);
+  // Algorithm 2: every frame plane adds one Gaussian; the peaks are seeded from the cells of
+  // this frame's planes and of the map's.
+  std::vector<Eigen::Vector3i> seeds;
+  for (const FramePlane& plane : frame_planes)
+  {
+    const float weight = voteWeight(plane);
+    voting_.addGaussian(global_, plane.hough, weight, cap);
+    Eigen::Vector3d mirrored;
+    if (param_.mirror(plane.hough, mirrored)) voting_.addGaussian(global_, mirrored, weight, cap);
+    seeds.push_back(nearestCell(param_.toCell(plane.hough)));
+  }
+  for (const DetectedPlane& plane : planes_) seeds.push_back(nearestCell(param_.toCell(plane.hough)));
+  const int evicted = static_cast<int>(global_.evictWeakest(static_cast<size_t>(params_.max_chunks)));
+  chunks_evicted_total_ += evicted;
+
+  const std::vector<HoughPeak> peaks = mergeSimilarPeaks(peak_search_.extract(global_, seeds, params_.global_threshold),
+                                                         params_.merge_angle, params_.merge_distance, param_);
+  matchIds(peaks, camera_position, stamp);
+  if (params_.forgetting == kForgetByEvidence) carryBeliefs();
+  return evicted;
+}
+
+void PlaneMap::thin(float cap)
+{
+  // By evidence, what is out of view keeps its state; the rest thins as in the paper.
+  if (params_.forgetting == kForgetByEvidence)
+    thinByEvidence(cap);
+  else
+    global_.thin(static_cast<float>(params_.thinning_rate), cap);
+}
+
+float PlaneMap::voteWeight(const FramePlane& plane) const
+{
+  // A plane not yet in the map adds up to 2 when strongly supported, so that a big plane is
+  // reported the first time it is seen, while known planes gain 1 per frame as in the paper
+  // (thinning and permanence keep their pace). Noisier sensors need more points for the same
+  // precision: the bar rises with sensor_noise^2. A plane of the parallel search, or one
+  // snapped to a known normal, measured only its offset, so a quarter of the points is as strong.
+  for (const DetectedPlane& known : planes_)
+  {
+    const double sign = known.normal.dot(plane.normal) >= 0.0 ? 1.0 : -1.0;
+    if (unsignedAngle(known.normal, plane.normal) < params_.merge_angle &&
+        std::abs(known.d - sign * plane.d) < params_.merge_distance)
+      return 1.0f;
+  }
+  if (params_.strong_support <= 0) return 1.0f;
+  const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
+  return static_cast<float>(1.0 + std::min(1.0, plane.support / (plane.parallel ? 0.25 * strong_support : strong_support)));
+}
+
+void PlaneMap::matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp)
+{
+  // Each peak takes the id of the closest previous plane it is similar to.
+  std::vector<DetectedPlane> previous;
+  previous.swap(planes_);
+  std::vector<bool> taken(previous.size(), false);
+  for (const HoughPeak& peak : peaks)
+  {
+    DetectedPlane plane;
+    plane.hough = peak.hough;
+    plane.strength = peak.value;
+    int match = -1;
+    double best_cost = 2.0;
+    for (size_t i = 0; i < previous.size(); ++i)
+    {
+      if (taken[i]) continue;
+      const double cost = unsignedAngle(previous[i].normal, peak.normal) / (2.0 * params_.merge_angle + 1e-9) +
+                          std::abs(std::abs(previous[i].d) - std::abs(peak.d)) / (2.0 * params_.merge_distance + 1e-9);
+      const double sign = previous[i].normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
+      if (std::abs(previous[i].d - sign * peak.d) > 2.0 * params_.merge_distance) continue;
+      if (cost < best_cost)
+      {
+        best_cost = cost;
+        match = static_cast<int>(i);
+      }
+    }
+    double sign;
+    if (match >= 0)
+    {
+      taken[match] = true;
+      plane.id = previous[match].id;
+      plane.first_seen = previous[match].first_seen;
+      plane.last_seen = previous[match].last_seen;
+      sign = previous[match].normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;  // keep the reported side
+    }
+    else
+    {
+      plane.id = next_id_++;
+      plane.first_seen = stamp;
+      plane.last_seen = stamp;
+      sign = peak.normal.dot(camera_position) + peak.d >= 0.0 ? 1.0 : -1.0;  // face the sensor
+    }
+    plane.normal = sign * peak.normal;
+    plane.d = sign * peak.d;
+    planes_.push_back(plane);
+  }
+
+}
+
+void PlaneMap::carryBeliefs()
+{
+  // A new plane starts at PlaneBelief's start, a plane that left the map takes its belief along.
+  std::unordered_map<int, PlaneBelief> beliefs;
+  for (DetectedPlane& plane : planes_)
+  {
+    const auto it = beliefs_.find(plane.id);
+    const PlaneBelief& belief = beliefs[plane.id] = it != beliefs_.end() ? it->second : PlaneBelief();
+    plane.confirmations = belief.confirmations;
+    plane.contradictions = belief.contradictions;
+  }
+  beliefs_.swap(beliefs);
+}
+
+void PlaneMap::observe(const std::vector<int>& support, const std::vector<int>& block_labels, const FrameData& frame,
+                       double stamp)
+{
+  for (size_t p = 0; p < planes_.size(); ++p)
+  {
+    planes_[p].support = support[p];
+    if (planes_[p].support >= params_.min_support) planes_[p].last_seen = stamp;
+  }
+  // Extents: this frame's labelled blocks mark their cells; cells fade like the Hough space
+  // (lazily, swept every 16 frames); extents of planes that left the map go with them.
+  const float fade = extentFade();
+  std::unordered_map<int, PlaneExtent> extents;
+  std::unordered_map<int, std::pair<PlaneExtent*, const DetectedPlane*>> by_id;
+  for (const DetectedPlane& plane : planes_)
+  {
+    auto it = extents_.find(plane.id);
+    PlaneExtent& extent = extents[plane.id];
+    if (it != extents_.end()) extent = std::move(it->second);
+    if (frame_count_ % 16 == 0) extent.sweep(frame_count_, fade);
+    by_id.emplace(plane.id, std::make_pair(&extent, &plane));
+  }
+  int last_id = -1;
+  const std::pair<PlaneExtent*, const DetectedPlane*>* target = nullptr;
+  for (size_t b = 0; b < block_labels.size(); ++b)
+  {
+    if (block_labels[b] < 0) continue;
+    if (block_labels[b] != last_id)  // neighbouring blocks mostly share a plane
+    {
+      last_id = block_labels[b];
+      target = &by_id.at(last_id);
+    }
+    const Eigen::Vector3d centroid = frame.camera_to_world * frame.blocks[b].centroid;
+    target->first->add(centroid, target->second->normal, target->second->d, frame_count_, fade);
+  }
+  extents_.swap(extents);
+}
+
+const PlaneExtent* PlaneMap::extent(int id) const
+{
+  const auto it = extents_.find(id);
+  return it == extents_.end() ? nullptr : &it->second;
+}
+
+float PlaneMap::extentFade() const
+{
+  // By evidence, where a plane was seen stays known until the plane goes.
+  return params_.forgetting == kForgetByEvidence ? 0.0f : static_cast<float>(params_.thinning_rate);
+}
+
+void PlaneMap::thinByEvidence(float cap)
+{
+  // The cells around each established map plane's peak (its blur and peak window, and the
+  // mirrored copy near the border) are kept as they are, a gone plane's are cleared; a plane
+  // not yet established thins like everything else.
+  const int r = voting_.blurRadius() + params_.peak_window / 2 + 1;
+  std::vector<std::pair<Eigen::Vector3i, float>> kept;
+  auto forBox = [&](const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) {
+    std::vector<Eigen::Vector3d> centres{hough};
+    Eigen::Vector3d mirrored;
+    if (param_.mirror(hough, mirrored)) centres.push_back(mirrored);
+    for (const Eigen::Vector3d& centre : centres)
+    {
+      const Eigen::Vector3d c = param_.toCell(centre);
+      const int cx = static_cast<int>(std::lround(c.x())), cy = static_cast<int>(std::lround(c.y())),
+                cz = static_cast<int>(std::lround(c.z()));
+      for (int x = cx - r; x <= cx + r; ++x)
+        for (int y = cy - r; y <= cy + r; ++y)
+          for (int z = cz - r; z <= cz + r; ++z) f(x, y, z);
+    }
+  };
+  for (const DetectedPlane& plane : planes_)
+  {
+    const auto belief = beliefs_.find(plane.id);
+    if (belief != beliefs_.end() && belief->second.gone())
+      forBox(plane.hough, [&](int x, int y, int z) {
+        const float v = global_.value(x, y, z);
+        if (v > 0.0f) global_.add(x, y, z, -v);
+      });
+    else if (belief != beliefs_.end() && belief->second.established())
+      forBox(plane.hough, [&](int x, int y, int z) {
+        const float v = global_.value(x, y, z);
+        if (v > 0.0f) kept.emplace_back(Eigen::Vector3i(x, y, z), v);
+      });
+  }
+  global_.thin(static_cast<float>(params_.thinning_rate), cap);
+  for (const auto& cell : kept)
+  {
+    const float now = global_.value(cell.first.x(), cell.first.y(), cell.first.z());
+    if (now < cell.second) global_.add(cell.first.x(), cell.first.y(), cell.first.z(), cell.second - now);
+  }
+}
+
+std::vector<std::vector<Eigen::Vector3d>> PlaneMap::regions(const DetectedPlane& plane) const
+{
+  const PlaneExtent* e = extent(plane.id);
+  return e ? e->regions(frame_count_, extentFade()) : std::vector<std::vector<Eigen::Vector3d>>();
+}
+
+std::vector<Eigen::Vector3d> PlaneMap::hull(const DetectedPlane& plane) const
+{
+  const PlaneExtent* e = extent(plane.id);
+  return e ? e->hull(frame_count_, extentFade()) : std::vector<Eigen::Vector3d>();
+}
+
+}  // namespace hough_plane_detector
