@@ -86,11 +86,27 @@ void findParallelPlanes(const DetectorParams& params, const HoughParameterizatio
       for (size_t i = best_begin; i < best_end; ++i)
       {
         if (used[i]) continue;
-        used[i] = 1;
         weight_sum += frame.blocks[offsets[i].second].fit_weight;
         weighted_d += frame.blocks[offsets[i].second].fit_weight * offsets[i].first;
       }
       double d = weighted_d / weight_sum;
+      // The interval may hold the tail of a neighbouring surface (a riser's top blocks below a
+      // tread): shift to the mode, the mean of what lies within half the interval of it.
+      for (int step = 0; step < 5; ++step)
+      {
+        const double half = 0.5 * params.support_distance;
+        double shift_weight = 0.0, shifted = 0.0;
+        for (auto it = std::lower_bound(offsets.begin(), offsets.end(), std::make_pair(d - half, -1));
+             it != offsets.end() && it->first <= d + half; ++it)
+        {
+          if (used[it - offsets.begin()]) continue;
+          shift_weight += frame.blocks[it->second].fit_weight;
+          shifted += frame.blocks[it->second].fit_weight * it->first;
+        }
+        if (shift_weight <= 0.0 || std::abs(shifted / shift_weight - d) < 1e-4) break;
+        d = shifted / shift_weight;
+      }
+      for (size_t i = best_begin; i < best_end; ++i) used[i] = 1;
       bool repeats = false;
       for (const KnownPlane& plane : known)
       {

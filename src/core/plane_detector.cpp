@@ -142,11 +142,6 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
 
 void PlaneDetector::estimateNormals(const CloudView& cloud)
 {
-  NormalEstimatorConfig normal_config;
-  normal_config.window = params_.normal_window;
-  normal_config.stride = params_.normal_stride;
-  normal_config.min_valid_fraction = params_.min_valid_fraction;
-  normal_config.max_curvature = params_.max_curvature;
   // The sensor's projection from the cloud itself (its focal length sets the disparity steps);
   // the last good estimate, or the sensor's nominal one, when this cloud cannot tell.
   const PinholeIntrinsics intrinsics = estimateIntrinsics(cloud);
@@ -155,13 +150,10 @@ void PlaneDetector::estimateNormals(const CloudView& cloud)
     intrinsics_ = intrinsics;
     focal_length_ = intrinsics.fx * 640.0 / cloud.width;
   }
-  frame_.noise = DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_);
-  normal_config.noise = frame_.noise;
-  normal_config.max_window_scale = params_.max_window_scale;
-  frame_.normals.compute(cloud, frame_.camera_to_world, normal_config, frame_.samples);
+  frame_.measure(cloud, frame_.camera_to_world, params_,
+                 DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_));
   stats_.windows_valid = frame_.normals.validWindows();
   stats_.samples = static_cast<int>(frame_.samples.size());
-  describeBlocks(frame_.normals, params_, frame_.noise, frame_.blocks);
 }
 
 void PlaneDetector::findLocalPeaks(std::vector<HoughPeak>& peaks)

@@ -9,6 +9,8 @@
 #include <Eigen/Geometry>
 
 #include "hough_plane_detector/core/block_regions.h"
+#include "hough_plane_detector/core/cloud_view.h"
+#include "hough_plane_detector/core/detector_params.h"
 #include "hough_plane_detector/core/normal_estimator.h"
 #include "hough_plane_detector/core/sensor_model.h"
 
@@ -23,6 +25,11 @@ struct FrameData
   DepthNoiseModel noise;              // the sensor's, for this frame
   Eigen::Isometry3d camera_to_world = Eigen::Isometry3d::Identity();
   std::vector<char> block_claim;  // blocks taken by an earlier plane of this frame
+
+  // Measures a cloud: windows' normals, blocks and their noise statistics, with `noise` and
+  // the parameters' window, stride and planarity limits.
+  void measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
+               const DepthNoiseModel& sensor_noise);
 
   int blocksX() const { return normals.blocksX(); }
   int blocksY() const { return normals.blocksY(); }

@@ -1,0 +1,110 @@
+// The persistent map (paper 3.6-3.7, Alg. 2) fed with per-frame planes directly.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hough_plane_detector/core/plane_map.h"
+
+using namespace hough_plane_detector;
+
+namespace
+{
+struct Map
+{
+  DetectorParams params;
+  HoughParameterization param{params.effectiveAngleStep(), params.effectiveDStep(), params.max_distance,
+                              params.blur_kernel_size / 2 + params.peak_window / 2 + 2};
+  HoughVoting voting{param, params.blur_kernel_size / 2, params.blur_sigma};
+  HoughPeakSearch search{param, params.peak_window / 2};
+  PlaneMap map{params, param, voting, search};
+
+  FramePlane plane(const Eigen::Vector3d& normal, double d, double support) const
+  {
+    FramePlane p;
+    p.normal = normal.normalized();
+    p.d = d;
+    p.hough = param.toHough(p.normal, d);
+    p.support = support;
+    return p;
+  }
+  void frame(const std::vector<FramePlane>& planes, double stamp)
+  {
+    map.beginFrame();
+    map.accumulate(planes, Eigen::Vector3d::Zero(), stamp);
+  }
+};
+const Eigen::Vector3d kFloor = Eigen::Vector3d::UnitZ();
+}  // namespace
+
+TEST(PlaneMap, AWeakPlaneNeedsASecondFrameAStrongOneDoesNot)
+{
+  Map m;
+  m.frame({m.plane(kFloor, 1.0, 3000)}, 0.0);  // 3,000 points: adds 1 + 3000 / 16000 < global_threshold
+  EXPECT_TRUE(m.map.planes().empty());
+  m.frame({m.plane(kFloor, 1.0, 3000)}, 1.0);
+  ASSERT_EQ(m.map.planes().size(), 1u);
+  EXPECT_EQ(m.map.planes()[0].first_seen, 1.0);
+
+  Map strong;
+  strong.frame({strong.plane(Eigen::Vector3d(1, 0, 0), -2.0, 16000)}, 0.0);
+  ASSERT_EQ(strong.map.planes().size(), 1u);
+  const DetectedPlane& wall = strong.map.planes()[0];
+  EXPECT_LT(std::acos(std::abs(wall.normal.x())), 0.002);
+  EXPECT_NEAR(std::abs(wall.d), 2.0, 0.005);
+  EXPECT_GT(wall.normal.dot(Eigen::Vector3d::Zero()) + wall.d, 0.0);  // faces the sensor at the origin
+}
+
+TEST(PlaneMap, IdsFollowAPlaneThatMovesALittleAndNewPlanesGetNewOnes)
+{
+  Map m;
+  for (int f = 0; f < 3; ++f) m.frame({m.plane(kFloor, 1.0, 20000)}, f);
+  ASSERT_EQ(m.map.planes().size(), 1u);
+  const int floor_id = m.map.planes()[0].id;
+  for (int f = 3; f < 6; ++f)
+    m.frame({m.plane(Eigen::AngleAxisd(0.004, Eigen::Vector3d::UnitY()) * kFloor, 1.006, 20000),
+             m.plane(Eigen::Vector3d(0, 1, 0), -3.0, 20000)},
+            f);
+  ASSERT_EQ(m.map.planes().size(), 2u);
+  for (const DetectedPlane& plane : m.map.planes())
+  {
+    if (std::abs(plane.normal.z()) > 0.9)
+      EXPECT_EQ(plane.id, floor_id);
+    else
+      EXPECT_NE(plane.id, floor_id);
+  }
+}
+
+TEST(PlaneMap, ThinningForgetsAPlaneNoFrameConfirms)
+{
+  Map m;
+  m.frame({m.plane(kFloor, 1.0, 20000)}, 0.0);
+  ASSERT_EQ(m.map.planes().size(), 1u);
+  // Peak 2 thins by thinning_rate a frame: below global_threshold after (2 - 1.5) / 0.05 frames.
+  int frames_kept = 0;
+  for (int f = 1; f < 40 && !m.map.planes().empty(); ++f, ++frames_kept) m.frame({}, f);
+  EXPECT_TRUE(m.map.planes().empty());
+  EXPECT_NEAR(frames_kept, (2.0 - m.params.global_threshold) / m.params.thinning_rate, 1.5);
+}
+
+TEST(PlaneMap, SerialisesToItselfExactly)
+{
+  Map m;
+  for (int f = 0; f < 4; ++f)
+    m.frame({m.plane(kFloor, 1.0, 20000), m.plane(Eigen::Vector3d(0.6, 0.8, 0), -2.5, 9000)}, f);
+  const std::string bytes = m.map.serialize();
+  Map restored;
+  std::string error;
+  ASSERT_TRUE(restored.map.deserialize(bytes, &error)) << error;
+  EXPECT_EQ(restored.map.serialize(), bytes);
+  ASSERT_EQ(restored.map.planes().size(), m.map.planes().size());
+  // The restored map goes on exactly as the original.
+  m.frame({m.plane(kFloor, 1.0, 20000)}, 4);
+  restored.frame({restored.plane(kFloor, 1.0, 20000)}, 4);
+  EXPECT_EQ(restored.map.serialize(), m.map.serialize());
+  // A changed byte is refused and leaves the map as it was.
+  std::string broken = bytes;
+  broken[broken.size() / 2] ^= 0x10;
+  EXPECT_FALSE(restored.map.deserialize(broken, &error));
+  EXPECT_NE(error.find("checksum"), std::string::npos) << error;
+  EXPECT_EQ(restored.map.serialize(), m.map.serialize());
+}
