@@ -24,14 +24,15 @@ void findParallelPlanes(const DetectorParams& params, const HoughParameterizatio
   {
     Eigen::Vector3d normal, normal_cam;
     double d, d_cam;
+    bool in_map;  // a map plane not yet seen in this frame: a cluster on it confirms it
   };
-  std::vector<KnownPlane> known;  // planes a cluster must not repeat, in both frames
-  auto addKnown = [&](const Eigen::Vector3d& normal, double d) {
+  std::vector<KnownPlane> known;  // in both frames
+  auto addKnown = [&](const Eigen::Vector3d& normal, double d, bool in_map) {
     known.push_back({normal, frame.camera_to_world.linear().transpose() * normal, d,
-                     d + normal.dot(frame.camera_to_world.translation())});
+                     d + normal.dot(frame.camera_to_world.translation()), in_map});
   };
-  for (const FramePlane& plane : planes) addKnown(plane.normal, plane.d);
-  for (const DetectedPlane& plane : map_planes) addKnown(plane.normal, plane.d);
+  for (const FramePlane& plane : planes) addKnown(plane.normal, plane.d, false);
+  for (const DetectedPlane& plane : map_planes) addKnown(plane.normal, plane.d, true);
   for (const KnownPlane& plane : known)
   {
     bool seen = false;
@@ -107,14 +108,15 @@ void findParallelPlanes(const DetectorParams& params, const HoughParameterizatio
         d = shifted / shift_weight;
       }
       for (size_t i = best_begin; i < best_end; ++i) used[i] = 1;
-      bool repeats = false;
-      for (const KnownPlane& plane : known)
-      {
+      // A cluster on a plane of this frame repeats it; one on a map plane measures it again
+      // (else a plane only this search sees would never be voted for twice).
+      auto sameAsCluster = [&](const KnownPlane& plane) {
         const double sign = plane.normal.dot(normal) >= 0.0 ? 1.0 : -1.0;
-        if (unsignedAngle(plane.normal, normal) < params.merge_angle &&
-            std::abs(d - sign * plane.d) < 2.0 * params.merge_distance)
-          repeats = true;
-      }
+        return unsignedAngle(plane.normal, normal) < params.merge_angle &&
+               std::abs(d - sign * plane.d) < 2.0 * params.merge_distance;
+      };
+      bool repeats = false;
+      for (const KnownPlane& plane : known) repeats |= !plane.in_map && sameAsCluster(plane);
       // Surfaces cut by a plane through the sensor all project to one image line, whose blocks
       // form that plane for any surface behind them: no plane can be seen edge-on.
       const double d_cam = d + shift;
@@ -133,7 +135,8 @@ void findParallelPlanes(const DetectorParams& params, const HoughParameterizatio
         if (frame.block_claim[offset.second] || std::abs(offset.first - d) > reach) continue;
         bool on_known = false;
         for (const KnownPlane& plane : known)
-          if (std::abs(plane.normal_cam.dot(info.centroid) + plane.d_cam) <= reach) on_known = true;
+          if (!sameAsCluster(plane) && std::abs(plane.normal_cam.dot(info.centroid) + plane.d_cam) <= reach)
+            on_known = true;
         if (!on_known) blocks.push_back(offset.second);
       }
       // A strip one block wide (a pillar's tangent line) shows no curvature across it; each
@@ -164,7 +167,7 @@ void findParallelPlanes(const DetectorParams& params, const HoughParameterizatio
         peak.support = moments.count;
         peak.parallel = true;
         planes.push_back(peak);
-        addKnown(normal, d);
+        addKnown(normal, d, false);
       }
       candidates.push_back(candidate);
     }
