@@ -80,67 +80,20 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
   // echoes of the same plane find nothing left; refined per-frame planes that agree to a
   // fraction of a cell keep the global peaks sharp.
   std::vector<char> claimed(frame_.samples.size(), 0);
-  const double overlap = static_cast<double>(params_.normal_stride * params_.normal_stride) /
-                         (params_.normal_window * params_.normal_window);
   frame_.block_claim.assign(static_cast<size_t>(frame_.normals.blocksX()) * frame_.normals.blocksY(), 0);
-  const double cos_limit = std::cos(params_.support_angle);
   std::vector<int> windows, blocks;
   for (const HoughPeak& peak : peaks)
   {
     Eigen::Vector3d normal = peak.normal;
     double d = peak.d;
     PointMoments moments, weighted;  // weighted: of the final blocks, reused by the planarity test
-    CandidateVerdict verdict = CandidateVerdict::kAccepted;
-    for (int pass = 0; pass < 3; ++pass)
-    {
-      windows.clear();
-      double window_points = 0.0;
-      for (size_t s = 0; s < frame_.samples.size(); ++s)
-      {
-        if (claimed[s] || std::abs(frame_.samples[s].normal.dot(normal)) < cos_limit) continue;
-        if (std::abs(normal.dot(frame_.samples[s].centroid) + d) <= params_.support_distance)
-        {
-          windows.push_back(static_cast<int>(s));
-          window_points += frame_.samples[s].count * overlap;
-        }
-      }
-      // Overlapping windows count their points about once each: too few, no fit needed.
-      if (window_points < params_.min_support)
-      {
-        moments = PointMoments();
-        verdict = CandidateVerdict::kTooFewPoints;
-        break;
-      }
-      moments = collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
-      if (moments.count < std::max(3, params_.min_support))
-      {
-        verdict = CandidateVerdict::kTooFewPoints;
-        break;
-      }
-      moments = tests_.keepFlatComponents(blocks, params_.merge_angle, 1);
-      if (moments.count < std::max(3, params_.min_support))
-      {
-        verdict = CandidateVerdict::kCurvedPatches;
-        break;
-      }
-      weighted = tests_.weightedMoments(blocks);
-      const PointMoments world = weighted.transformed(frame_.camera_to_world);
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-      solver.computeDirect(world.covariance());
-      Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
-      if (n.dot(normal) < 0.0) n = -n;
-      const double d_new = -n.dot(world.mean());
-      // Converged: another pass would select the same windows and blocks.
-      const bool converged = pass > 0 && unsignedAngle(n, normal) < 2e-4 && std::abs(d_new - d) < 5e-4;
-      normal = n;
-      d = d_new;
-      if (converged) break;
-    }
+    CandidateVerdict verdict = refineOnWindows(claimed, normal, d, windows, blocks, moments, weighted);
     if (verdict == CandidateVerdict::kAccepted && !tests_.isPlanarFit(weighted, blocks))
       verdict = CandidateVerdict::kCentroidsOffPlane;
     else if (verdict == CandidateVerdict::kAccepted && !tests_.halvesAgree(blocks, 0, blocks.size(), params_.merge_angle))
       verdict = CandidateVerdict::kHalvesDisagree;
-    const bool snapped = verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, blocks, map_planes, planes);
+    const bool snapped =
+        verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, blocks, map_planes, planes);
     candidates.push_back({normal, d, peak.value, moments.count, verdict});
     if (verdict != CandidateVerdict::kAccepted) continue;
     // Claim everything within support_distance, not just the tight fit, so that leftovers
@@ -160,6 +113,52 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
   }
 }
 
+CandidateVerdict FramePlaneFitter::refineOnWindows(const std::vector<char>& claimed, Eigen::Vector3d& normal, double& d,
+                                                   std::vector<int>& windows, std::vector<int>& blocks,
+                                                   PointMoments& moments, PointMoments& weighted)
+{
+  const double overlap = static_cast<double>(params_.normal_stride * params_.normal_stride) /
+                         (params_.normal_window * params_.normal_window);
+  const double cos_limit = std::cos(params_.support_angle);
+  for (int pass = 0; pass < 3; ++pass)
+  {
+    windows.clear();
+    double window_points = 0.0;
+    for (size_t s = 0; s < frame_.samples.size(); ++s)
+    {
+      if (claimed[s] || std::abs(frame_.samples[s].normal.dot(normal)) < cos_limit) continue;
+      if (std::abs(normal.dot(frame_.samples[s].centroid) + d) <= params_.support_distance)
+      {
+        windows.push_back(static_cast<int>(s));
+        window_points += frame_.samples[s].count * overlap;
+      }
+    }
+    // Overlapping windows count their points about once each: too few, no fit needed.
+    if (window_points < params_.min_support)
+    {
+      moments = PointMoments();
+      return CandidateVerdict::kTooFewPoints;
+    }
+    moments = collectPlaneBlocks(normal, d, windows, blocks, pass > 0);
+    if (moments.count < std::max(3, params_.min_support)) return CandidateVerdict::kTooFewPoints;
+    moments = tests_.keepFlatComponents(blocks, params_.merge_angle, 1);
+    if (moments.count < std::max(3, params_.min_support)) return CandidateVerdict::kCurvedPatches;
+    weighted = tests_.weightedMoments(blocks);
+    const PointMoments world = weighted.transformed(frame_.camera_to_world);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(world.covariance());
+    Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
+    if (n.dot(normal) < 0.0) n = -n;
+    const double d_new = -n.dot(world.mean());
+    // Converged: another pass would select the same windows and blocks.
+    const bool converged = pass > 0 && unsignedAngle(n, normal) < 2e-4 && std::abs(d_new - d) < 5e-4;
+    normal = n;
+    d = d_new;
+    if (converged) break;
+  }
+  return CandidateVerdict::kAccepted;
+}
+
 void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const std::vector<DetectedPlane>& map_planes,
                                    std::vector<FramePlane>& planes, std::vector<PlaneCandidate>& candidates)
 {
@@ -176,27 +175,12 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     PlaneRegion region = grower.grow(seed, n_cam, d_cam, frame_.block_claim);
     for (int b : region.blocks) tried[b] = 1;
     for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
-    CandidateVerdict verdict = CandidateVerdict::kAccepted;
     PointMoments moments;
-    if (region.points < std::max(3, params_.min_support))
-      verdict = CandidateVerdict::kTooFewPoints;
-    else if ((moments = tests_.keepFlatComponents(region.blocks, params_.merge_angle, 1)).count < std::max(3, params_.min_support))
-      verdict = CandidateVerdict::kCurvedPatches;
-    else if (!grower.fit(region.blocks, region.normal, region.d))  // of the flat components kept
-      verdict = CandidateVerdict::kTooFewPoints;
-    else if (grower.seenEdgeOn(region.blocks, region.normal))
-      verdict = CandidateVerdict::kEdgeOn;
-    else if (grower.normalsTurn(region.blocks, region.normal))
-      verdict = CandidateVerdict::kCurvedPatches;
-    else if (grower.centroidsBend(region.blocks, region.normal, region.d))
-      verdict = CandidateVerdict::kCurvedPatches;
-    else if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
-      verdict = CandidateVerdict::kCentroidsOffPlane;
-    else if (!tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
-      verdict = CandidateVerdict::kHalvesDisagree;
+    const CandidateVerdict verdict = testRegion(grower, region, moments);
     Eigen::Vector3d normal = frame_.camera_to_world.linear() * region.normal;
     double d = region.d - normal.dot(frame_.camera_to_world.translation());
-    const bool snapped = verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, map_planes, planes);
+    const bool snapped =
+        verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, map_planes, planes);
     candidates.push_back({normal, d, peak_value, std::max(region.points, moments.count), verdict});
     if (verdict != CandidateVerdict::kAccepted) return;
     for (int b : region.blocks) frame_.block_claim[b] = 1;
@@ -239,17 +223,33 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
   }
 }
 
-bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
-                                            const std::vector<DetectedPlane>& map_planes,
-                                            const std::vector<FramePlane>& planes) const
+CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, PlaneRegion& region,
+                                              PointMoments& moments) const
 {
-  // A small or far plane nearly parallel to a known one (a stair tread to the floor, a shelf
-  // top) is fitted with a tilt of a few degrees: blocks of the surfaces it meets lean on its
-  // edges. If most of its points lie on a plane of the known normal within their noise, that
-  // plane, with one parameter fewer, is the better model.
+  // Each test against the sensor's noise at the blocks' depths; the fit is of the flat
+  // components kept.
+  const double min_points = std::max(3, params_.min_support);
+  if (region.points < min_points) return CandidateVerdict::kTooFewPoints;
+  if ((moments = tests_.keepFlatComponents(region.blocks, params_.merge_angle, 1)).count < min_points)
+    return CandidateVerdict::kCurvedPatches;
+  if (!grower.fit(region.blocks, region.normal, region.d)) return CandidateVerdict::kTooFewPoints;
+  if (grower.seenEdgeOn(region.blocks, region.normal)) return CandidateVerdict::kEdgeOn;
+  if (grower.normalsTurn(region.blocks, region.normal) || grower.centroidsBend(region.blocks, region.normal, region.d))
+    return CandidateVerdict::kCurvedPatches;
+  if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
+    return CandidateVerdict::kCentroidsOffPlane;
+  if (!tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
+    return CandidateVerdict::kHalvesDisagree;
+  return CandidateVerdict::kAccepted;
+}
+
+const Eigen::Vector3d* FramePlaneFitter::closestKnownNormal(const Eigen::Vector3d& normal,
+                                                           const std::vector<DetectedPlane>& map_planes,
+                                                           const std::vector<FramePlane>& planes) const
+{
   const Eigen::Vector3d* closest = nullptr;
   double closest_angle = params_.snap_angle;
-  auto consider = [&](const Eigen::Vector3d& known_normal) {  // an element of map_planes or planes
+  auto consider = [&](const Eigen::Vector3d& known_normal) {
     const double angle = unsignedAngle(known_normal, normal);
     if (angle < closest_angle)
     {
@@ -259,6 +259,18 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   };
   for (const DetectedPlane& plane : map_planes) consider(plane.normal);
   for (const FramePlane& plane : planes) consider(plane.normal);
+  return closest;
+}
+
+bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
+                                            const std::vector<DetectedPlane>& map_planes,
+                                            const std::vector<FramePlane>& planes) const
+{
+  // A small or far plane nearly parallel to a known one (a stair tread to the floor, a shelf
+  // top) is fitted with a tilt of a few degrees: blocks of the surfaces it meets lean on its
+  // edges. If most of its points lie on a plane of the known normal within their noise, that
+  // plane, with one parameter fewer, is the better model.
+  const Eigen::Vector3d* closest = closestKnownNormal(normal, map_planes, planes);
   if (!closest || blocks.empty()) return false;
   const Eigen::Vector3d known = closest->dot(normal) >= 0.0 ? *closest : Eigen::Vector3d(-*closest);
   const Eigen::Vector3d n_cam = frame_.camera_to_world.linear().transpose() * known;

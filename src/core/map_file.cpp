@@ -142,6 +142,92 @@ std::string PlaneMap::serialize() const
   return withChecksum(w.bytes);
 }
 
+namespace
+{
+// The parts of a map file after its header, each read whole or not at all; "" when read.
+std::string readPlanes(Reader& r, std::vector<DetectedPlane>& planes)
+{
+  uint32_t plane_count;
+  if (!r.get(plane_count)) return "map header is truncated";
+  // Counts are checked against the bytes left before anything is allocated for them.
+  constexpr size_t kPlaneBytes = 4 + 3 * 8 + 8 + 8 + 4 + 8 + 8 + 3 * 8;
+  if (plane_count > r.remaining() / kPlaneBytes) return "map plane count does not fit the file (truncated?)";
+  planes.resize(plane_count);
+  for (DetectedPlane& p : planes)
+  {
+    int32_t id, support;
+    bool ok = r.get(id);
+    for (int i = 0; i < 3; ++i) ok = ok && r.get(p.normal(i));
+    ok = ok && r.get(p.d) && r.get(p.strength) && r.get(support) && r.get(p.first_seen) && r.get(p.last_seen);
+    for (int i = 0; i < 3; ++i) ok = ok && r.get(p.hough(i));
+    if (!ok) return "map planes are truncated";
+    p.id = id;
+    p.support = support;
+  }
+  return "";
+}
+
+std::string readChunks(Reader& r, size_t top_level, std::vector<std::pair<int32_t, std::vector<float>>>& chunks)
+{
+  uint32_t chunk_count;
+  if (!r.get(chunk_count)) return "map chunk list is truncated";
+  constexpr size_t kChunkBytes = 4 + sizeof(float) * SparseHoughSpace::kChunkCells;
+  if (chunk_count > r.remaining() / kChunkBytes) return "map chunk count does not fit the file (truncated?)";
+  chunks.resize(chunk_count);
+  for (auto& chunk : chunks)
+  {
+    chunk.second.resize(SparseHoughSpace::kChunkCells);
+    if (!r.get(chunk.first) || !r.getBytes(chunk.second.data(), sizeof(float) * SparseHoughSpace::kChunkCells))
+      return "map chunks are truncated";
+    if (chunk.first < 0 || static_cast<size_t>(chunk.first) >= top_level)
+      return "map chunk index " + std::to_string(chunk.first) + " is outside the Hough space";
+  }
+  return "";
+}
+
+std::string readExtents(Reader& r, std::unordered_map<int, PlaneExtent>& extents)
+{
+  uint32_t extent_count;
+  if (!r.get(extent_count)) return "map extents are truncated";
+  for (uint32_t i = 0; i < extent_count; ++i)
+  {
+    int32_t id;
+    uint32_t cell_count;
+    Eigen::Vector3d axes[3];
+    bool ok = r.get(id);
+    for (auto& axis : axes)
+      for (int i = 0; i < 3; ++i) ok = ok && r.get(axis(i));
+    if (!ok || !r.get(cell_count) || cell_count > PlaneExtent::kMaxCells) return "map extents are truncated";
+    PlaneExtent& extent = extents[id];
+    extent.setBasis(PlaneBasis(axes[0], axes[1], axes[2]));
+    for (uint32_t c = 0; c < cell_count; ++c)
+    {
+      int32_t x, y;
+      PlaneExtent::Cell cell;
+      if (!r.get(x) || !r.get(y) || !r.get(cell.weight) || !r.get(cell.seen)) return "map extents are truncated";
+      extent.setCell(x, y, cell);
+    }
+  }
+  return "";
+}
+
+std::string readBeliefs(Reader& r, std::unordered_map<int, PlaneBelief>& beliefs)
+{
+  uint32_t belief_count;
+  constexpr size_t kBeliefBytes = 4 + 8 + 8 + 8;
+  if (!r.get(belief_count) || belief_count > r.remaining() / kBeliefBytes) return "map beliefs are truncated";
+  for (uint32_t i = 0; i < belief_count; ++i)
+  {
+    int32_t id;
+    PlaneBelief belief;
+    if (!r.get(id) || !r.get(belief.log_odds) || !r.get(belief.confirmations) || !r.get(belief.contradictions))
+      return "map beliefs are truncated";
+    beliefs[id] = belief;
+  }
+  return "";
+}
+}  // namespace
+
 bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
 {
   auto fail = [error](const std::string& what) {
@@ -167,9 +253,8 @@ bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
   double angle_step, d_step, max_distance;
   int32_t size_angle, size_d, next_id;
   int64_t frame_count;
-  uint32_t plane_count;
   if (!r.get(angle_step) || !r.get(d_step) || !r.get(max_distance) || !r.get(size_angle) || !r.get(size_d) ||
-      !r.get(next_id) || !r.get(frame_count) || !r.get(plane_count))
+      !r.get(next_id) || !r.get(frame_count))
     return fail("map header is truncated");
   if (std::abs(angle_step - param_.angleStep()) > 1e-12 || std::abs(d_step - param_.dStep()) > 1e-12 ||
       std::abs(max_distance - param_.maxDistance()) > 1e-12 || size_angle != param_.sizeAngle() ||
@@ -182,72 +267,15 @@ bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
          << ", max_distance " << param_.maxDistance() << ", blur and peak windows as configured";
     return fail(what.str());
   }
-  // Counts are checked against the bytes left before anything is allocated for them.
-  constexpr size_t kPlaneBytes = 4 + 3 * 8 + 8 + 8 + 4 + 8 + 8 + 3 * 8;
-  if (plane_count > r.remaining() / kPlaneBytes) return fail("map plane count does not fit the file (truncated?)");
-  std::vector<DetectedPlane> planes(plane_count);
-  for (DetectedPlane& p : planes)
-  {
-    int32_t id, support;
-    bool ok = r.get(id);
-    for (int i = 0; i < 3; ++i) ok = ok && r.get(p.normal(i));
-    ok = ok && r.get(p.d) && r.get(p.strength) && r.get(support) && r.get(p.first_seen) && r.get(p.last_seen);
-    for (int i = 0; i < 3; ++i) ok = ok && r.get(p.hough(i));
-    if (!ok) return fail("map planes are truncated");
-    p.id = id;
-    p.support = support;
-  }
-  uint32_t chunk_count;
-  if (!r.get(chunk_count)) return fail("map chunk list is truncated");
-  constexpr size_t kChunkBytes = 4 + sizeof(float) * SparseHoughSpace::kChunkCells;
-  if (chunk_count > r.remaining() / kChunkBytes) return fail("map chunk count does not fit the file (truncated?)");
-  const size_t top_level = global_.topLevelCount();
-  std::vector<std::pair<int32_t, std::vector<float>>> chunks(chunk_count);
-  for (auto& chunk : chunks)
-  {
-    chunk.second.resize(SparseHoughSpace::kChunkCells);
-    if (!r.get(chunk.first) || !r.getBytes(chunk.second.data(), sizeof(float) * SparseHoughSpace::kChunkCells))
-      return fail("map chunks are truncated");
-    if (chunk.first < 0 || static_cast<size_t>(chunk.first) >= top_level)
-      return fail("map chunk index " + std::to_string(chunk.first) + " is outside the Hough space");
-  }
-  uint32_t extent_count;
-  if (!r.get(extent_count)) return fail("map extents are truncated");
+  std::vector<DetectedPlane> planes;
+  std::vector<std::pair<int32_t, std::vector<float>>> chunks;
   std::unordered_map<int, PlaneExtent> extents;
-  for (uint32_t i = 0; i < extent_count; ++i)
-  {
-    int32_t id;
-    uint32_t cell_count;
-    Eigen::Vector3d axes[3];
-    bool ok = r.get(id);
-    for (auto& axis : axes)
-      for (int i = 0; i < 3; ++i) ok = ok && r.get(axis(i));
-    if (!ok || !r.get(cell_count) || cell_count > PlaneExtent::kMaxCells) return fail("map extents are truncated");
-    PlaneExtent& extent = extents[id];
-    extent.setBasis(PlaneBasis(axes[0], axes[1], axes[2]));
-    for (uint32_t c = 0; c < cell_count; ++c)
-    {
-      int32_t x, y;
-      PlaneExtent::Cell cell;
-      if (!r.get(x) || !r.get(y) || !r.get(cell.weight) || !r.get(cell.seen)) return fail("map extents are truncated");
-      extent.setCell(x, y, cell);
-    }
-  }
   std::unordered_map<int, PlaneBelief> beliefs;
-  if (version >= 2)
-  {
-    uint32_t belief_count;
-    constexpr size_t kBeliefBytes = 4 + 8 + 8 + 8;
-    if (!r.get(belief_count) || belief_count > r.remaining() / kBeliefBytes) return fail("map beliefs are truncated");
-    for (uint32_t i = 0; i < belief_count; ++i)
-    {
-      int32_t id;
-      PlaneBelief belief;
-      if (!r.get(id) || !r.get(belief.log_odds) || !r.get(belief.confirmations) || !r.get(belief.contradictions))
-        return fail("map beliefs are truncated");
-      beliefs[id] = belief;
-    }
-  }
+  std::string problem = readPlanes(r, planes);
+  if (problem.empty()) problem = readChunks(r, global_.topLevelCount(), chunks);
+  if (problem.empty()) problem = readExtents(r, extents);
+  if (problem.empty() && version >= 2) problem = readBeliefs(r, beliefs);
+  if (!problem.empty()) return fail(problem);
   if (r.position() != bytes.size() - sizeof(uint64_t)) return fail("map has trailing bytes");
 
   // Everything read and checked: only now replace the state.

@@ -79,6 +79,17 @@ public:
                             const std::vector<DetectedPlane>& map_planes, const std::vector<FramePlane>& planes) const;
 
 private:
+  // The paper's refinement: up to three passes of taking the unclaimed windows near the
+  // plane, their blocks on it, and refitting. The verdict when it ran out of points.
+  CandidateVerdict refineOnWindows(const std::vector<char>& claimed, Eigen::Vector3d& normal, double& d,
+                                   std::vector<int>& windows, std::vector<int>& blocks, PointMoments& moments,
+                                   PointMoments& weighted);
+  // The planarity tests of a grown region, in order; the flat components' moments in `moments`.
+  CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
+  // The normal of the map's or this frame's planes closest to `normal` within snap_angle, or nullptr.
+  const Eigen::Vector3d* closestKnownNormal(const Eigen::Vector3d& normal, const std::vector<DetectedPlane>& map_planes,
+                                            const std::vector<FramePlane>& planes) const;
+
   const DetectorParams& params_;
   const HoughParameterization& param_;
   FrameData& frame_;
