@@ -65,6 +65,13 @@ struct Frame
     }
     return out;
   }
+  // The middle image row of the blocks.
+  int wallRow(const std::vector<int>& blocks) const
+  {
+    int low = frame.blocksY(), high = 0;
+    for (int b : blocks) low = std::min(low, b / frame.blocksX()), high = std::max(high, b / frame.blocksX());
+    return (low + high) / 2;
+  }
   HoughPeak peakOf(const TruePlane& truth) const
   {
     HoughPeak peak;
@@ -100,6 +107,32 @@ TEST(PlanarityTests, TheLikelihoodRatioTellsTheTrueNormalFromOneDegreeOff)
   const Eigen::Vector3d tilted = Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d::UnitX()) * n_cam;
   EXPECT_GT(f.tests.snapChi2Increase(tilted, wall), kMaxSnapChi2Increase);
   EXPECT_FALSE(f.tests.explainedByNormal(tilted, wall));
+}
+
+TEST(PlanarityTests, ANormalNeedsSpreadAcrossMoreThanAFewBlocks)
+{
+  Frame f;
+  const std::vector<int> wall = f.blocksOn(f.truePlane("wall"));
+  ASSERT_GT(wall.size(), 100u);
+  const double bound = f.params.merge_angle / 2.0;  // FramePlaneFitter's limit
+  EXPECT_LT(f.tests.normalUncertainty(wall), 0.2 * bound);
+  // One image row of the wall's blocks: a line in space, no tilt about it is measured.
+  const int row = f.wallRow(wall);
+  std::vector<int> strip;
+  for (int b : wall)
+    if (b / f.frame.blocksX() == row) strip.push_back(b);
+  ASSERT_GT(strip.size(), 20u);
+  EXPECT_GT(f.tests.normalUncertainty(strip), bound);
+  // Nor may a few blocks off the row (a strip along a shelf's edge and some on the wall).
+  int added = 0;
+  for (int b : wall)
+    if (b / f.frame.blocksX() == row + 10 && added < 3) strip.push_back(b), ++added;
+  ASSERT_EQ(added, 3);
+  EXPECT_GT(f.tests.normalUncertainty(strip), bound);
+  // Three rows do.
+  for (int b : wall)
+    if (b / f.frame.blocksX() == row + 1 || b / f.frame.blocksX() == row + 2) strip.push_back(b);
+  EXPECT_LT(f.tests.normalUncertainty(strip), bound);
 }
 
 TEST(FramePlaneFitter, BothFitsRecoverTheFloorAndTheWallFromTheirPeaks)

@@ -26,6 +26,7 @@ const char* toString(CandidateVerdict verdict)
     case CandidateVerdict::kHalvesDisagree: return "halves disagree";
     case CandidateVerdict::kNotParallel: return "not parallel to the known plane";
     case CandidateVerdict::kEdgeOn: return "seen edge-on";
+    case CandidateVerdict::kNormalUndetermined: return "normal undetermined";
   }
   return "unknown";
 }
@@ -94,6 +95,8 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
       verdict = CandidateVerdict::kHalvesDisagree;
     const bool snapped =
         verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, blocks, map_planes, planes);
+    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(blocks))
+      verdict = CandidateVerdict::kNormalUndetermined;
     candidates.push_back({normal, d, peak.value, moments.count, verdict});
     if (verdict != CandidateVerdict::kAccepted) continue;
     // Claim everything within support_distance, not just the tight fit, so that leftovers
@@ -176,12 +179,18 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     for (int b : region.blocks) tried[b] = 1;
     for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
     PointMoments moments;
-    const CandidateVerdict verdict = testRegion(grower, region, moments);
+    CandidateVerdict verdict = testRegion(grower, region, moments);
     Eigen::Vector3d normal = frame_.camera_to_world.linear() * region.normal;
     double d = region.d - normal.dot(frame_.camera_to_world.translation());
     const bool snapped =
         verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, map_planes, planes);
+    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(region.blocks))
+      verdict = CandidateVerdict::kNormalUndetermined;
     candidates.push_back({normal, d, peak_value, std::max(region.points, moments.count), verdict});
+    // A region on one surface that its points cannot orient keeps its blocks from the next
+    // regions: they would only orient them as badly.
+    if (verdict == CandidateVerdict::kNormalUndetermined)
+      for (int b : region.blocks) frame_.block_claim[b] = 1;
     if (verdict != CandidateVerdict::kAccepted) return;
     for (int b : region.blocks) frame_.block_claim[b] = 1;
     FramePlane refined;
@@ -241,6 +250,13 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
   if (!tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
     return CandidateVerdict::kHalvesDisagree;
   return CandidateVerdict::kAccepted;
+}
+
+bool FramePlaneFitter::normalDetermined(const std::vector<int>& blocks) const
+{
+  // Within merge_angle at three sigmas, so that every frame's fit of the surface lands on one
+  // Hough peak; a plane the points cannot orient (a strip along a shelf's edge) is no plane.
+  return tests_.normalUncertainty(blocks) <= params_.merge_angle / 2.0;
 }
 
 const Eigen::Vector3d* FramePlaneFitter::closestKnownNormal(const Eigen::Vector3d& normal,

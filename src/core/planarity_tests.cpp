@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include <Eigen/Eigenvalues>
 
@@ -82,6 +83,44 @@ bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, s
     if (tilt > max_angle && (!params_.region_growing || tilt > 3.0 * std::sqrt(tilt_variance))) return false;
   }
   return true;
+}
+
+double PlanarityTests::normalUncertainty(const std::vector<int>& blocks) const
+{
+  // Each centroid weighted by the inverse of its own variance (quantization and systematic
+  // error included: they do not average out within a block).
+  PointMoments moments;
+  std::vector<double> weights;
+  weights.reserve(blocks.size());
+  for (int b : blocks)
+  {
+    const double weight = 1.0 / (frame_.blocks[b].centroid_variance + kCentroidFloor);
+    PointMoments m = centroidMoments(frame_.moments(b));
+    weights.push_back(m.count > 0.0 ? weight : 0.0);
+    if (m.count <= 0.0) continue;
+    m.scale(weight / m.count);
+    moments.add(m);
+  }
+  if (blocks.size() < 3 || moments.count <= 0.0) return M_PI / 2;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(moments.covariance());
+  // The tilt about the long axis is fixed by the spread across it (the middle axis). That
+  // must not hinge on a few blocks (a row along a shelf's edge and two off it, on the wall):
+  // the most informative tenth, at least two, is left out.
+  const Eigen::Vector3d across = solver.eigenvectors().col(1);
+  const Eigen::Vector3d mean = moments.mean();
+  std::vector<double> information;
+  information.reserve(blocks.size());
+  for (size_t i = 0; i < blocks.size(); ++i)
+  {
+    const double x = across.dot(frame_.blocks[blocks[i]].centroid - mean);
+    information.push_back(weights[i] * x * x);
+  }
+  const size_t left_out = std::min(information.size() - 1, std::max<size_t>(2, information.size() / 10));
+  std::nth_element(information.begin(), information.begin() + left_out, information.end(), std::greater<double>());
+  double kept = 0.0;
+  for (size_t i = left_out; i < information.size(); ++i) kept += information[i];
+  return kept > 0.0 ? std::min(M_PI / 2, 1.0 / std::sqrt(kept)) : M_PI / 2;
 }
 
 PointMoments PlanarityTests::weightedMoments(const std::vector<int>& blocks) const

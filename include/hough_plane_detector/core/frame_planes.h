@@ -27,6 +27,7 @@ enum class CandidateVerdict
   kHalvesDisagree,     // the fits of its two halves differ by more than merge_angle
   kNotParallel,        // parallel search: its blocks' own fit is not parallel to the known plane
   kEdgeOn,             // region: most rays graze its plane, which their depths cannot test
+  kNormalUndetermined,  // its points fix its normal no better than merge_angle / 3 (1 sigma), and no known normal fits
 };
 const char* toString(CandidateVerdict verdict);
 
@@ -86,6 +87,8 @@ private:
                                    PointMoments& weighted);
   // The planarity tests of a grown region, in order; the flat components' moments in `moments`.
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
+  // True when the blocks fix the normal within merge_angle / 3 (one sigma).
+  bool normalDetermined(const std::vector<int>& blocks) const;
   // The normal of the map's or this frame's planes closest to `normal` within snap_angle, or nullptr.
   const Eigen::Vector3d* closestKnownNormal(const Eigen::Vector3d& normal, const std::vector<DetectedPlane>& map_planes,
                                             const std::vector<FramePlane>& planes) const;

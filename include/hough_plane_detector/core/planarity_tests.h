@@ -44,6 +44,10 @@ public:
   double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
   // True when the blocks' own fit is within 2 merge_angle of the camera-frame normal.
   bool fitIsParallel(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
+  // Standard error (rad) of the normal the blocks' centroids fit, about the axis it is least
+  // sure of: 1 / sqrt(sum of w x^2) over the weighted centroids' spread across that axis. A
+  // strip of blocks along one image row fixes no tilt about its own length.
+  double normalUncertainty(const std::vector<int>& blocks) const;
   // Moments of the blocks' centroids, each weighted by the inverse variance of the sensor at its depth.
   PointMoments weightedMoments(const std::vector<int>& blocks) const;
 

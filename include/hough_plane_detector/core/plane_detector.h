@@ -84,6 +84,10 @@ public:
   const DepthNoiseModel& noiseModel() const { return frame_.noise; }
   // Every local peak of the last frame that was tested as a plane, strongest first.
   const std::vector<PlaneCandidate>& lastCandidates() const { return candidates_; }
+  // The accepted planes of the last frame, as voted into the map (world frame).
+  const std::vector<FramePlane>& lastFramePlanes() const { return frame_planes_; }
+  // The last frame as the stages measured it (blocks, windows, noise, pose).
+  const FrameData& lastFrame() const { return frame_; }
   MemoryReport memory() const;
   const DetectorParams& params() const { return params_; }
   const HoughParameterization& parameterization() const { return param_; }
