@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -657,12 +658,12 @@ void randomSceneExperiment(Report& report)
   auto runSeed = [&](uint32_t seed, std::vector<MethodStats>& set, bool row) {
     const RandomScene room = makeRandomScene(seed, frames);
     const SceneRenderer renderer(room.scene);
-    std::vector<PlaneDetector> detectors;
+    std::vector<std::unique_ptr<PlaneDetector>> detectors;
     for (const Variant& variant : variants)
     {
       DetectorParams params = paramsFor(room.noise, 1024);
       variant.change(params);
-      detectors.emplace_back(params);
+      detectors.push_back(std::make_unique<PlaneDetector>(params));
     }
     std::vector<MethodStats> stats(variants.size());
     KinectNoise noise;
@@ -670,10 +671,10 @@ void randomSceneExperiment(Report& report)
     for (int f = 0; f < frames; ++f)
     {
       const RenderedFrame frame = renderer.render(room.poses[f], noise, seed * 1000 + f);
-      for (PlaneDetector& detector : detectors) detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
+      for (auto& detector : detectors) detector->processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
       if (f < kWarmupFrames || (f - kWarmupFrames) % 3 != 0) continue;
       for (size_t v = 0; v < variants.size(); ++v)
-        stats[v].add(evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints, mapPlanes(detectors[v])));
+        stats[v].add(evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints, mapPlanes(*detectors[v])));
     }
     if (row)
       rows += fmt("| %u | %s | %.1f %% | %.2f | %.1f %% | %.2f |\n", seed, room.description.c_str(),

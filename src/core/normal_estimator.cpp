@@ -85,7 +85,38 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
   blocks_y_ = cloud.height / s;
   blocks_.assign(static_cast<size_t>(blocks_x_) * blocks_y_, PointMoments());
   if (blocks_x_ == 0 || blocks_y_ == 0) return;
+  accumulateBlocks(cloud, s);
 
+  const int k = config.window / s;
+  const int step = config.stride / s;
+  use_integral_ = k > 1 || config.max_window_scale > 1;  // wider windows read it too
+  if (use_integral_) buildIntegral();
+
+  const double min_count = config.min_valid_fraction * config.window * config.window;
+  const Eigen::Matrix3d rotation = camera_to_world.linear();
+  const Eigen::Vector3d translation = camera_to_world.translation();
+  for (int wy = 0; wy + k <= blocks_y_; wy += step)
+    for (int wx = 0; wx + k <= blocks_x_; wx += step)
+    {
+      const double count = windowMoments(wx, wy, wx + k, wy + k).count;
+      if (count < min_count) continue;
+      ++valid_windows_;
+      Eigen::Vector3d normal, mean;
+      if (!measureWindow(wx, wy, k, config, normal, mean)) continue;
+      if (normal.dot(mean) > 0.0) normal = -normal;  // toward the sensor at the origin
+      WindowSample sample;
+      sample.normal = rotation * normal;
+      sample.centroid = rotation * mean + translation;
+      sample.d = -sample.normal.dot(sample.centroid);
+      sample.count = static_cast<int>(count);  // votes count the window's own points
+      sample.window_x = wx;
+      sample.window_y = wy;
+      samples.push_back(sample);
+    }
+}
+
+void NormalEstimator::accumulateBlocks(const CloudView& cloud, int s)
+{
   // Per block, float sums relative to the block's first valid point keep full precision
   // (sums of squares of metres in float would swamp millimetre noise); doubles after that.
   struct BlockAccumulator
@@ -159,14 +190,14 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
       m.yz = b.yz + ry * b.sz + rz * b.sy + n * ry * rz;
     }
   }
+}
 
+void NormalEstimator::buildIntegral()
+{
   // Summed-area table over blocks: a window of k x k blocks costs four look-ups.
-  const int k = config.window / s;
-  const int step = config.stride / s;
   const int ix = blocks_x_ + 1;
-  const bool need_table = k > 1 || config.max_window_scale > 1;  // wider windows read it too
-  if (need_table) integral_.assign(static_cast<size_t>(ix) * (blocks_y_ + 1), PointMoments());
-  for (int by = 0; by < blocks_y_ && need_table; ++by)
+  integral_.assign(static_cast<size_t>(ix) * (blocks_y_ + 1), PointMoments());
+  for (int by = 0; by < blocks_y_; ++by)
   {
     PointMoments row_sum;
     for (int bx = 0; bx < blocks_x_; ++bx)
@@ -177,81 +208,61 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
       cell.add(row_sum);
     }
   }
+}
 
-  const double min_count = config.min_valid_fraction * config.window * config.window;
-  const Eigen::Matrix3d rotation = camera_to_world.linear();
-  const Eigen::Vector3d translation = camera_to_world.translation();
+PointMoments NormalEstimator::windowMoments(int x0, int y0, int x1, int y1) const
+{
+  x0 = std::max(0, x0);
+  y0 = std::max(0, y0);
+  x1 = std::min(blocks_x_, x1);
+  y1 = std::min(blocks_y_, y1);
+  if (!use_integral_) return blocks_[static_cast<size_t>(y0) * blocks_x_ + x0];
+  const int ix = blocks_x_ + 1;
+  PointMoments m = integral_[static_cast<size_t>(y1) * ix + x1];
+  m.subtract(integral_[static_cast<size_t>(y0) * ix + x1]);
+  m.subtract(integral_[static_cast<size_t>(y1) * ix + x0]);
+  m.add(integral_[static_cast<size_t>(y0) * ix + x0]);
+  return m;
+}
+
+bool NormalEstimator::measureWindow(int wx, int wy, int k, const NormalEstimatorConfig& config,
+                                    Eigen::Vector3d& normal, Eigen::Vector3d& mean) const
+{
+  // Far from a Kinect a window can be as thick (noise) as it is wide, and its normal is then
+  // mostly noise: measure it again over a window twice, then four times, as wide around it.
+  // The widest planar measurement wins; a wider window that crosses an edge keeps the last.
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  // Moments of the blocks [x0, x1) x [y0, y1), clipped to the grid.
-  auto windowMoments = [&](int x0, int y0, int x1, int y1) {
-    x0 = std::max(0, x0);
-    y0 = std::max(0, y0);
-    x1 = std::min(blocks_x_, x1);
-    y1 = std::min(blocks_y_, y1);
-    if (!need_table) return blocks_[static_cast<size_t>(y0) * blocks_x_ + x0];
-    PointMoments m = integral_[static_cast<size_t>(y1) * ix + x1];
-    m.subtract(integral_[static_cast<size_t>(y0) * ix + x1]);
-    m.subtract(integral_[static_cast<size_t>(y1) * ix + x0]);
-    m.add(integral_[static_cast<size_t>(y0) * ix + x0]);
-    return m;
-  };
-  for (int wy = 0; wy + k <= blocks_y_; wy += step)
+  bool planar = false;
+  for (int scale = 1; scale <= config.max_window_scale; scale *= 2)
   {
-    for (int wx = 0; wx + k <= blocks_x_; wx += step)
-    {
-      const PointMoments base = windowMoments(wx, wy, wx + k, wy + k);
-      if (base.count < min_count) continue;
-      ++valid_windows_;
-      // Far from a Kinect a window can be as thick (noise) as it is wide, and its normal is then
-      // mostly noise: measure it again over a window twice, then four times, as wide around it.
-      // The widest planar measurement wins; a wider window that crosses an edge keeps the last.
-      PointMoments m = base;
-      bool planar = false;
-      Eigen::Vector3d normal, mean;
-      for (int scale = 1; scale <= config.max_window_scale; scale *= 2)
-      {
-        if (scale > 1)
-        {
-          const int x0 = wx - k * (scale - 1) / 2, y0 = wy - k * (scale - 1) / 2;
-          m = windowMoments(x0, y0, x0 + k * scale, y0 + k * scale);
-        }
-        // Depth noise moves points along their rays, which tilts a plain covariance normal
-        // toward the ray on oblique surfaces (0.1 rad on a wall 2.5 m away seen at 45 deg at
-        // C = 1): the noise covariance along the ray is taken out, no more of it than the
-        // window's own thickness shows (so a window less noisy than the model is not over-corrected).
-        const Eigen::Vector3d centre = m.mean();
-        const double sigma = config.noise.sigma(centre.z());
-        const Eigen::Vector3d ray = centre / centre.z();  // a depth error e moves a point by e * ray
-        const Eigen::Matrix3d covariance = m.covariance();
-        solver.computeDirect(covariance);
-        const double ray_along_normal = ray.dot(solver.eigenvectors().col(0));
-        const double noise_variance = std::min(sigma * sigma, std::max(0.0, solver.eigenvalues()(0)) /
-                                                                   std::max(1e-9, ray_along_normal * ray_along_normal));
-        if (noise_variance > 0.0) solver.computeDirect(covariance - noise_variance * ray * ray.transpose());
-        const Eigen::Vector3d eigenvalues = solver.eigenvalues();
-        const double trace = eigenvalues.sum();
-        if (!(trace > 0.0)) break;
-        // Planar when flat relative to its size, or no rougher than the sensor's noise at that
-        // depth (far windows of a Kinect are never flat in the first sense).
-        const double noise = 3.0 * sigma;
-        if (eigenvalues(0) > config.max_curvature * trace && eigenvalues(0) > noise * noise) continue;
-        planar = true;
-        normal = solver.eigenvectors().col(0);
-        mean = centre;
-        if (eigenvalues(0) <= kMaxThicknessRatio * eigenvalues(1)) break;
-      }
-      if (!planar) continue;
-      if (normal.dot(mean) > 0.0) normal = -normal;  // toward the sensor at the origin
-      WindowSample sample;
-      sample.normal = rotation * normal;
-      sample.centroid = rotation * mean + translation;
-      sample.d = -sample.normal.dot(sample.centroid);
-      sample.count = static_cast<int>(base.count);  // votes count the window's own points
-      sample.window_x = wx;
-      sample.window_y = wy;
-      samples.push_back(sample);
-    }
+    const int x0 = wx - k * (scale - 1) / 2, y0 = wy - k * (scale - 1) / 2;
+    const PointMoments m = windowMoments(x0, y0, x0 + k * scale, y0 + k * scale);
+    // Depth noise moves points along their rays, which tilts a plain covariance normal
+    // toward the ray on oblique surfaces (0.1 rad on a wall 2.5 m away seen at 45 deg at
+    // C = 1): the noise covariance along the ray is taken out, no more of it than the
+    // window's own thickness shows (so a window less noisy than the model is not over-corrected).
+    const Eigen::Vector3d centre = m.mean();
+    const double sigma = config.noise.sigma(centre.z());
+    const Eigen::Vector3d ray = centre / centre.z();  // a depth error e moves a point by e * ray
+    const Eigen::Matrix3d covariance = m.covariance();
+    solver.computeDirect(covariance);
+    const double ray_along_normal = ray.dot(solver.eigenvectors().col(0));
+    const double noise_variance = std::min(sigma * sigma, std::max(0.0, solver.eigenvalues()(0)) /
+                                                               std::max(1e-9, ray_along_normal * ray_along_normal));
+    if (noise_variance > 0.0) solver.computeDirect(covariance - noise_variance * ray * ray.transpose());
+    const Eigen::Vector3d eigenvalues = solver.eigenvalues();
+    const double trace = eigenvalues.sum();
+    if (!(trace > 0.0)) break;
+    // Planar when flat relative to its size, or no rougher than the sensor's noise at that
+    // depth (far windows of a Kinect are never flat in the first sense).
+    const double noise = 3.0 * sigma;
+    if (eigenvalues(0) > config.max_curvature * trace && eigenvalues(0) > noise * noise) continue;
+    planar = true;
+    normal = solver.eigenvectors().col(0);
+    mean = centre;
+    if (eigenvalues(0) <= kMaxThicknessRatio * eigenvalues(1)) break;
   }
+  return planar;
 }
 
 }  // namespace hough_plane_detector

@@ -58,6 +58,8 @@ class FramePlaneFitter
 public:
   FramePlaneFitter(const DetectorParams& params, const HoughParameterization& param, FrameData& frame,
                    const PlanarityTests& tests);
+  FramePlaneFitter(const FramePlaneFitter&) = delete;  // holds references to its owner's state
+  FramePlaneFitter& operator=(const FramePlaneFitter&) = delete;
 
   // The paper's fit, strongest peak first: each peak takes the windows that agree with it and
   // no earlier plane took and their blocks, refitted until they no longer change. A plane may snap

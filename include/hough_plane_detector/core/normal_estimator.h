@@ -71,8 +71,21 @@ public:
   int validWindows() const { return valid_windows_; }
 
 private:
+  // Point moments of every s x s pixel block.
+  void accumulateBlocks(const CloudView& cloud, int s);
+  // The summed-area table over the blocks (when windows span several blocks).
+  void buildIntegral();
+  // Moments of the blocks [x0, x1) x [y0, y1), clipped to the grid.
+  PointMoments windowMoments(int x0, int y0, int x1, int y1) const;
+  // The normal and centre of the k x k-block window at (wx, wy), camera frame, measured over
+  // up to max_window_scale times wider windows while it is as thick as half its width; false
+  // when no measurement is planar.
+  bool measureWindow(int wx, int wy, int k, const NormalEstimatorConfig& config, Eigen::Vector3d& normal,
+                     Eigen::Vector3d& mean) const;
+
   int blocks_x_ = 0, blocks_y_ = 0;
   int valid_windows_ = 0;
+  bool use_integral_ = false;
   std::vector<PointMoments> blocks_;
   std::vector<PointMoments> integral_;  // (blocks_x_ + 1) x (blocks_y_ + 1) summed-area table
 };

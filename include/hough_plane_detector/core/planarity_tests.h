@@ -22,6 +22,8 @@ class PlanarityTests
 {
 public:
   PlanarityTests(const DetectorParams& params, const FrameData& frame);
+  PlanarityTests(const PlanarityTests&) = delete;  // holds references to its owner's state
+  PlanarityTests& operator=(const PlanarityTests&) = delete;
 
   // True when the block centroids of a fitted plane scatter no more than the sensor's noise.
   bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;

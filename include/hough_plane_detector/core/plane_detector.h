@@ -71,6 +71,10 @@ class PlaneDetector
 public:
   // Throws std::invalid_argument naming the problem when params.validate() fails.
   explicit PlaneDetector(const DetectorParams& params);
+  // The stages keep references to the detector's own parameters and frame: it stays where it
+  // was built (hold it by std::unique_ptr to move it).
+  PlaneDetector(const PlaneDetector&) = delete;
+  PlaneDetector& operator=(const PlaneDetector&) = delete;
 
   // Adds one organized frame; returns false (map untouched) with `error` set on bad input.
   bool processFrame(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, double stamp,

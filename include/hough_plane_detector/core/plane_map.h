@@ -32,6 +32,8 @@ public:
   // kernel and the peak search are the detector's.
   PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
            const HoughPeakSearch& peak_search);
+  PlaneMap(const PlaneMap&) = delete;  // holds references to its owner's state
+  PlaneMap& operator=(const PlaneMap&) = delete;
 
   // Counts the frame (extents and evidence age by frames).
   void beginFrame() { ++frame_count_; }
