@@ -10,6 +10,44 @@
 namespace hough_plane_detector
 {
 
+namespace
+{
+geometry_msgs::Polygon toPolygon(const std::vector<Eigen::Vector3d>& vertices)
+{
+  geometry_msgs::Polygon polygon;
+  for (const Eigen::Vector3d& v : vertices)
+  {
+    geometry_msgs::Point32 q;
+    q.x = static_cast<float>(v.x());
+    q.y = static_cast<float>(v.y());
+    q.z = static_cast<float>(v.z());
+    polygon.points.push_back(q);
+  }
+  return polygon;
+}
+}  // namespace
+
+Plane toPlaneMsg(const DetectedPlane& plane, const std::vector<Eigen::Vector3d>& hull,
+                 const std::vector<std::vector<Eigen::Vector3d>>& regions)
+{
+  Plane msg;
+  msg.id = plane.id;
+  msg.coef.coef = {plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.d};
+  msg.normal.x = plane.normal.x();
+  msg.normal.y = plane.normal.y();
+  msg.normal.z = plane.normal.z();
+  msg.d = plane.d;
+  msg.strength = plane.strength;
+  msg.support = static_cast<uint32_t>(plane.support);
+  msg.confirmations = static_cast<uint32_t>(plane.confirmations);
+  msg.contradictions = static_cast<uint32_t>(plane.contradictions);
+  msg.first_seen.fromSec(plane.first_seen);
+  msg.last_seen.fromSec(plane.last_seen);
+  msg.hull = toPolygon(hull);
+  for (const auto& region : regions) msg.regions.push_back(toPolygon(region));
+  return msg;
+}
+
 std_msgs::ColorRGBA colourForId(int id, float alpha)
 {
   const double hue = std::fmod(0.13 + 0.618033988749895 * id, 1.0) * 6.0;

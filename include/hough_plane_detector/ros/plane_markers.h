@@ -1,4 +1,4 @@
-// RViz markers, the segmented cloud and the pcl_msgs outputs for the plane map.
+// The plane map as messages: Plane, RViz markers, the segmented cloud and the pcl_msgs outputs.
 #pragma once
 
 #include <cstdint>
@@ -12,11 +12,15 @@
 
 #include "hough_plane_detector/ClusterPointIndices.h"
 #include "hough_plane_detector/ModelCoefficientsArray.h"
+#include "hough_plane_detector/Plane.h"
 #include "hough_plane_detector/core/plane_detector.h"
 
 namespace hough_plane_detector
 {
 
+// A map plane with its extent's hull and regions (world frame) as a Plane message.
+Plane toPlaneMsg(const DetectedPlane& plane, const std::vector<Eigen::Vector3d>& hull,
+                 const std::vector<std::vector<Eigen::Vector3d>>& regions);
 // A stable, well-spread colour per plane id (golden-ratio hues).
 std_msgs::ColorRGBA colourForId(int id, float alpha);
 // DELETEALL, sent first in every array so that no marker of a vanished plane stays.
