@@ -56,6 +56,31 @@ void depthImageToPoints(const float* metres, int width, int height, size_t row_s
             points);
 }
 
+namespace
+{
+constexpr double kDisparityOffset = 3.3309495161;   // 1/m
+constexpr double kDisparityScale = -0.0030711016;  // 1/m per raw unit
+constexpr uint16_t kNoDisparity = 2047;
+}  // namespace
+
+uint16_t kinectDisparityToMillimetres(uint16_t raw, const CameraIntrinsics& intrinsics)
+{
+  if (raw >= kNoDisparity) return 0;
+  const double inverse_depth = kDisparityOffset + kDisparityScale * raw;
+  if (!(inverse_depth > 0.0)) return 0;
+  const double metres = 1.0 / inverse_depth;
+  if (metres < intrinsics.min_range || metres > intrinsics.max_range) return 0;
+  return static_cast<uint16_t>(std::lround(metres * 1000.0));
+}
+
+uint16_t kinectMetresToDisparity(double metres)
+{
+  if (!(metres > 0.0) || !std::isfinite(metres)) return kNoDisparity;
+  const double raw = (1.0 / metres - kDisparityOffset) / kDisparityScale;
+  if (!(raw >= 0.0) || raw >= kNoDisparity) return kNoDisparity;
+  return static_cast<uint16_t>(std::lround(raw));
+}
+
 CameraIntrinsics intrinsicsFromFieldOfView(int width, int height, double horizontal_fov, double vertical_fov)
 {
   CameraIntrinsics k;

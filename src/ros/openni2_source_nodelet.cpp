@@ -1,6 +1,7 @@
-// A Kinect path on Debian, where openni2_camera is not packaged: the first OpenNI2 depth device
-// (or ~device_uri, also an .oni recording) as organized clouds on depth/points in
-// camera_depth_optical_frame, openni2_camera's names.
+// An Xtion / PrimeSense path on Debian, where openni2_camera is not packaged: the first OpenNI2
+// depth device (or ~device_uri, also an .oni recording) at 640 x 480 millimetres as
+// depth/image_raw, depth/camera_info and the organized depth/points in
+// camera_depth_optical_frame (openni2_camera's names), stamped from the device's clock.
 #include <atomic>
 #include <memory>
 #include <thread>
@@ -9,10 +10,9 @@
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
-#include <sensor_msgs/PointCloud2.h>
-#include <sensor_msgs/point_cloud2_iterator.h>
 
 #include "hough_plane_detector/core/depth_image.h"
+#include "hough_plane_detector/ros/depth_camera_publisher.h"
 
 namespace hough_plane_detector
 {
@@ -63,53 +63,70 @@ private:
                     which.c_str(), openniError().c_str());
       return;
     }
-    if (stream_.create(device_, openni::SENSOR_DEPTH) != openni::STATUS_OK || stream_.start() != openni::STATUS_OK)
+    if (stream_.create(device_, openni::SENSOR_DEPTH) != openni::STATUS_OK)
     {
       NODELET_FATAL("The OpenNI2 device has no usable depth stream: %s", openniError().c_str());
+      return;
+    }
+    selectVgaMillimetres();
+    if (stream_.start() != openni::STATUS_OK)
+    {
+      NODELET_FATAL("The OpenNI2 depth stream did not start: %s", openniError().c_str());
       return;
     }
     const openni::VideoMode mode = stream_.getVideoMode();
     intrinsics_ = intrinsicsFromFieldOfView(mode.getResolutionX(), mode.getResolutionY(),
                                             stream_.getHorizontalFieldOfView(), stream_.getVerticalFieldOfView());
-    metres_per_unit_ = mode.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_100_UM ? 0.0001 : 0.001;
-    cloud_pub_ = getNodeHandle().advertise<sensor_msgs::PointCloud2>("depth/points", 2);
+    tenths_of_millimetres_ = mode.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_100_UM;
+    publisher_.advertise(getNodeHandle());
     NODELET_INFO("OpenNI2 depth %d x %d at %d fps, fx %.1f, on %s.", mode.getResolutionX(), mode.getResolutionY(),
-                 mode.getFps(), intrinsics_.fx, cloud_pub_.getTopic().c_str());
+                 mode.getFps(), intrinsics_.fx, getNodeHandle().resolveName("depth/points").c_str());
     running_ = true;
     reader_ = std::thread([this] { readLoop(); });
+  }
+
+  // An Xtion starts in QVGA: ask for 640 x 480 millimetres at the highest rate up to 30 fps.
+  void selectVgaMillimetres()
+  {
+    const openni::SensorInfo& info = stream_.getSensorInfo();
+    const openni::Array<openni::VideoMode>& modes = info.getSupportedVideoModes();
+    int best = -1;
+    for (int i = 0; i < modes.getSize(); ++i)
+    {
+      const openni::VideoMode& m = modes[i];
+      if (m.getResolutionX() != 640 || m.getResolutionY() != 480 || m.getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM ||
+          m.getFps() > 30)
+        continue;
+      if (best < 0 || m.getFps() > modes[best].getFps()) best = i;
+    }
+    if (best < 0 || stream_.setVideoMode(modes[best]) != openni::STATUS_OK)
+      NODELET_WARN("The OpenNI2 device offers no 640 x 480 millimetre depth mode: using its default.");
   }
 
   void readLoop()
   {
     openni::VideoStream* streams[1] = {&stream_};
-    std::vector<float> points;
+    std::vector<uint16_t> millimetres;
     while (running_ && ros::ok())
     {
       int ready = -1;
       if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, 500) != openni::STATUS_OK) continue;
       openni::VideoFrameRef frame;
       if (stream_.readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) continue;
-      if (cloud_pub_.getNumSubscribers() == 0) continue;
-      depthImageToPoints(static_cast<const uint16_t*>(frame.getData()), frame.getWidth(), frame.getHeight(),
-                         frame.getStrideInBytes(), intrinsics_, metres_per_unit_, points);
-      sensor_msgs::PointCloud2::Ptr cloud(new sensor_msgs::PointCloud2);
-      cloud->header.stamp = ros::Time::now();
-      cloud->header.frame_id = frame_id_;
-      sensor_msgs::PointCloud2Modifier modifier(*cloud);
-      modifier.setPointCloud2FieldsByString(1, "xyz");
-      modifier.resize(points.size() / 3);
-      cloud->width = frame.getWidth();
-      cloud->height = frame.getHeight();
-      cloud->row_step = cloud->point_step * cloud->width;
-      cloud->is_dense = false;
-      sensor_msgs::PointCloud2Iterator<float> it(*cloud, "x");
-      for (size_t i = 0; i < points.size(); i += 3, ++it)
+      const ros::Time stamp = clock_.stamp(frame.getTimestamp(), ros::Time::now());  // microseconds
+      const uint16_t* depth = static_cast<const uint16_t*>(frame.getData());
+      size_t stride = frame.getStrideInBytes();
+      if (tenths_of_millimetres_)
       {
-        it[0] = points[i];
-        it[1] = points[i + 1];
-        it[2] = points[i + 2];
+        millimetres.resize(static_cast<size_t>(frame.getWidth()) * frame.getHeight());
+        for (int v = 0; v < frame.getHeight(); ++v)
+          for (int u = 0; u < frame.getWidth(); ++u)
+            millimetres[static_cast<size_t>(v) * frame.getWidth() + u] =
+                reinterpret_cast<const uint16_t*>(reinterpret_cast<const uint8_t*>(depth) + v * stride)[u] / 10;
+        depth = millimetres.data();
+        stride = frame.getWidth() * sizeof(uint16_t);
       }
-      cloud_pub_.publish(cloud);
+      publisher_.publish(depth, frame.getWidth(), frame.getHeight(), stride, intrinsics_, frame_id_, stamp);
     }
   }
 
@@ -117,9 +134,10 @@ private:
   openni::Device device_;
   openni::VideoStream stream_;
   CameraIntrinsics intrinsics_;
-  double metres_per_unit_ = 0.001;
+  bool tenths_of_millimetres_ = false;  // PIXEL_FORMAT_DEPTH_100_UM
   std::string frame_id_;
-  ros::Publisher cloud_pub_;
+  DeviceClock clock_{1.0e6};  // OpenNI2 frame timestamps are microseconds
+  DepthCameraPublisher publisher_;
   std::atomic<bool> running_{false};
   std::thread reader_;
 };

@@ -19,6 +19,14 @@ void depthImageToPoints(const uint16_t* depth, int width, int height, size_t row
 void depthImageToPoints(const float* metres, int width, int height, size_t row_stride, const CameraIntrinsics& intrinsics,
                         std::vector<float>& points);
 
+// A Kinect v1's raw 11-bit disparity (libfreenect's FREENECT_DEPTH_11BIT, the only mode
+// fakenect plays) as depth by the sensor's nominal calibration, z = 1 / (3.3309495 -
+// 0.0030711016 raw) m (N. Burrus' fit): 0 for no return (2047) and for values no depth in
+// [min_range, max_range] gives (a truncated frame's zeros).
+uint16_t kinectDisparityToMillimetres(uint16_t raw, const CameraIntrinsics& intrinsics);
+// The inverse, for recordings of rendered depths: the nearest raw disparity, 2047 for no return.
+uint16_t kinectMetresToDisparity(double metres);
+
 // Pinhole intrinsics of a sensor from its image size and fields of view (radians).
 CameraIntrinsics intrinsicsFromFieldOfView(int width, int height, double horizontal_fov, double vertical_fov);
 

@@ -1,0 +1,155 @@
+// A Kinect v1 through Debian's libfreenect (OpenNI2 in Debian has no Kinect driver): depth at
+// VGA as depth/image_raw (16UC1 mm), depth/camera_info and the organized depth/points, with
+// openni2_camera's names, stamped from the device's frame timestamps. Run under fakenect
+// (LD_LIBRARY_PATH=<libdir>/fakenect FAKENECT_PATH=<dump>) it plays a recording instead.
+#include <atomic>
+#include <cstdlib>
+#include <fstream>
+#include <thread>
+#include <vector>
+
+#include <libfreenect.h>
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+
+#include "hough_plane_detector/core/depth_image.h"
+#include "hough_plane_detector/ros/depth_camera_publisher.h"
+
+namespace hough_plane_detector
+{
+
+class FreenectSourceNodelet : public nodelet::Nodelet
+{
+public:
+  ~FreenectSourceNodelet() override
+  {
+    running_ = false;
+    if (reader_.joinable()) reader_.join();
+    if (device_)
+    {
+      freenect_stop_depth(device_);
+      freenect_close_device(device_);
+    }
+    if (context_) freenect_shutdown(context_);
+  }
+
+private:
+  void onInit() override
+  {
+    ros::NodeHandle& private_nh = getPrivateNodeHandle();
+    int device_index;
+    private_nh.param("device_index", device_index, 0);
+    private_nh.param<std::string>("frame_id", frame_id_, "camera_depth_optical_frame");
+    // The Kinect's nominal depth-camera projection; ~fx.. override it with a calibration.
+    private_nh.param("fx", intrinsics_.fx, intrinsics_.fx);
+    private_nh.param("fy", intrinsics_.fy, intrinsics_.fy);
+    private_nh.param("cx", intrinsics_.cx, intrinsics_.cx);
+    private_nh.param("cy", intrinsics_.cy, intrinsics_.cy);
+    private_nh.param("device_clock_hz", device_clock_hz_, 60.0e6);
+    if (!(device_clock_hz_ > 0.0))
+    {
+      NODELET_ERROR("~device_clock_hz must be > 0, got %g; using 60e6.", device_clock_hz_);
+      device_clock_hz_ = 60.0e6;
+    }
+    clock_ = DeviceClock(device_clock_hz_);
+    publisher_.advertise(getNodeHandle());
+    if (!fakenectRecordingReadable()) return;
+    if (!openDevice(device_index)) return;
+    running_ = true;
+    reader_ = std::thread([this] { readLoop(); });
+    NODELET_INFO("Kinect v1 %d streaming depth (640 x 480, 11-bit disparity) on %s.", device_index,
+                 getNodeHandle().resolveName("depth/points").c_str());
+  }
+
+  // fakenect ends the whole process when its recording is missing: refuse it here instead.
+  bool fakenectRecordingReadable()
+  {
+    const char* path = std::getenv("FAKENECT_PATH");
+    if (!path) return true;
+    const std::string index = std::string(path) + "/INDEX.txt";
+    if (std::ifstream(index).good()) return true;
+    NODELET_ERROR("FAKENECT_PATH=%s has no readable INDEX.txt (a fakenect-record dump): no depth will be published.",
+                  path);
+    return false;
+  }
+
+  bool openDevice(int device_index)
+  {
+    if (freenect_init(&context_, nullptr) < 0)
+    {
+      NODELET_ERROR("libfreenect could not start (USB access?): no depth will be published.");
+      context_ = nullptr;
+      return false;
+    }
+    freenect_select_subdevices(context_, FREENECT_DEVICE_CAMERA);
+    const int devices = freenect_num_devices(context_);
+    if (device_index < 0 || device_index >= devices || freenect_open_device(context_, &device_, device_index) < 0)
+    {
+      NODELET_ERROR("No Kinect v1 number %d (%d found; is it plugged in, and may this user open it?): no depth "
+                    "will be published.", device_index, devices);
+      device_ = nullptr;
+      return false;
+    }
+    const freenect_frame_mode mode = freenect_find_depth_mode(FREENECT_RESOLUTION_MEDIUM, FREENECT_DEPTH_11BIT);
+    if (!mode.is_valid || freenect_set_depth_mode(device_, mode) < 0)
+    {
+      NODELET_ERROR("The Kinect refused 640 x 480 11-bit depth: no depth will be published.");
+      return false;
+    }
+    width_ = mode.width;
+    height_ = mode.height;
+    freenect_set_user(device_, this);
+    freenect_set_depth_callback(device_, [](freenect_device* device, void* depth, uint32_t timestamp) {
+      static_cast<FreenectSourceNodelet*>(freenect_get_user(device))->onDepth(static_cast<const uint16_t*>(depth), timestamp);
+    });
+    if (freenect_start_depth(device_) < 0)
+    {
+      NODELET_ERROR("The Kinect's depth stream did not start: no depth will be published.");
+      return false;
+    }
+    return true;
+  }
+
+  void readLoop()
+  {
+    timeval timeout{0, 100000};
+    while (running_ && ros::ok())
+      if (freenect_process_events_timeout(context_, &timeout) < 0)
+      {
+        NODELET_INFO("The Kinect's depth stream ended (the end of a fakenect recording, or the device is gone).");
+        break;
+      }
+  }
+
+  void onDepth(const uint16_t* raw, uint32_t ticks)
+  {
+    // The 32-bit frame counter wraps: unwrapped here, so the clock sees it grow.
+    if (have_ticks_ && ticks < last_ticks_) wraps_ += uint64_t(1) << 32;
+    have_ticks_ = true;
+    last_ticks_ = ticks;
+    const ros::Time stamp = clock_.stamp(wraps_ + ticks, ros::Time::now());
+    millimetres_.resize(static_cast<size_t>(width_) * height_);
+    for (size_t i = 0; i < millimetres_.size(); ++i) millimetres_[i] = kinectDisparityToMillimetres(raw[i], intrinsics_);
+    publisher_.publish(millimetres_.data(), width_, height_, width_ * sizeof(uint16_t), intrinsics_, frame_id_, stamp);
+  }
+
+  freenect_context* context_ = nullptr;
+  freenect_device* device_ = nullptr;
+  int width_ = 640, height_ = 480;
+  CameraIntrinsics intrinsics_;
+  std::string frame_id_;
+  double device_clock_hz_ = 60.0e6;
+  DeviceClock clock_{60.0e6};
+  bool have_ticks_ = false;
+  uint32_t last_ticks_ = 0;
+  uint64_t wraps_ = 0;
+  std::vector<uint16_t> millimetres_;
+  DepthCameraPublisher publisher_;
+  std::atomic<bool> running_{false};
+  std::thread reader_;
+};
+
+}  // namespace hough_plane_detector
+
+PLUGINLIB_EXPORT_CLASS(hough_plane_detector::FreenectSourceNodelet, nodelet::Nodelet)
