@@ -754,3 +754,37 @@ TEST(PlaneDetector, RegionGrowingRefusesCurvedAndEdgeOnRegions)
   EXPECT_GT(refused[CandidateVerdict::kCurvedPatches], 0);
   EXPECT_GT(refused[CandidateVerdict::kEdgeOn], 0);
 }
+
+// The map's reach is a matter of memory, not of distance from the origin: a corridor's end wall
+// 40 m from where the map began is found when the camera gets near it (the old 10 m reach lost
+// it, counted in lastStats().votes_out_of_range), and the Hough space stays small.
+TEST(PlaneDetector, AFortyMetreCorridorKeepsItsFarEnd)
+{
+  Scene corridor;
+  corridor.addRectangle(Eigen::Vector3d(20, 0, 0), kX, kY, 20.5, 1.0, "floor");
+  corridor.addRectangle(Eigen::Vector3d(20, -1, 1.25), kX, kZ, 20.5, 1.25, "wall_right");
+  corridor.addRectangle(Eigen::Vector3d(20, 1, 1.25), kX, kZ, 20.5, 1.25, "wall_left");
+  corridor.addRectangle(Eigen::Vector3d(40, 0, 1.25), kY, kZ, 1.0, 1.25, "far_end");
+  SceneRenderer renderer(corridor);
+  auto run = [&](double max_distance, int* out_of_range) {
+    DetectorParams params;
+    params.max_distance = max_distance;
+    auto detector = std::make_unique<PlaneDetector>(params);
+    for (int f = 0; f < 36; ++f)
+    {
+      const Eigen::Vector3d eye(1.0 + f, 0.0, 1.2);
+      feed(*detector, renderer.render(lookAt(eye, eye + Eigen::Vector3d(1.0, 0.0, -0.15)), kinect(1.0), 4000 + f), f);
+    }
+    *out_of_range = detector->lastStats().votes_out_of_range;
+    return detector;
+  };
+  int out_of_range = 0;
+  const auto far_reach = run(DetectorParams().max_distance, &out_of_range);
+  EXPECT_EQ(out_of_range, 0);
+  EXPECT_EQ(matching(far_reach->planes(), kX, -40.0, 0.01, 0.02).size(), 1u) << describe(far_reach->planes());
+  EXPECT_EQ(matching(far_reach->planes(), kZ, 0.0, 0.01, 0.02).size(), 1u) << describe(far_reach->planes());
+  EXPECT_LT(far_reach->memory().global_bytes, 2u * 1000 * 1000);
+  const auto room_reach = run(10.0, &out_of_range);
+  EXPECT_GT(out_of_range, 0);
+  EXPECT_TRUE(matching(room_reach->planes(), kX, -40.0, 0.01, 0.02).empty());
+}

@@ -12,12 +12,23 @@ SparseHoughSpace::SparseHoughSpace(int size_x, int size_y, int size_z)
   chunks_x_ = (size_x + kChunkEdge - 1) / kChunkEdge;
   chunks_y_ = (size_y + kChunkEdge - 1) / kChunkEdge;
   chunks_z_ = (size_z + kChunkEdge - 1) / kChunkEdge;
-  chunks_.resize(static_cast<size_t>(chunks_x_) * chunks_y_ * chunks_z_);
+  slabs_.resize(chunks_z_);
+}
+
+std::unique_ptr<float[]>& SparseHoughSpace::slot(int chunk_index)
+{
+  Slab& slab = slabs_[chunk_index % chunks_z_];
+  if (!slab)
+  {
+    slab.reset(new std::unique_ptr<float[]>[static_cast<size_t>(chunks_x_) * chunks_y_]);
+    ++slab_count_;
+  }
+  return slab[chunk_index / chunks_z_];
 }
 
 float* SparseHoughSpace::allocateChunk(int chunk_index)
 {
-  auto& slot = chunks_[chunk_index];
+  auto& slot = this->slot(chunk_index);
   if (!slot)
   {
     if (!pool_.empty())
@@ -76,7 +87,7 @@ void SparseHoughSpace::thin(float rate, float cap)
   kept.reserve(allocated_.size());
   for (int chunk_index : allocated_)
   {
-    float* chunk = chunks_[chunk_index].get();
+    float* chunk = slot(chunk_index).get();
     float any = 0.0f;
     for (int i = 0; i < kChunkCells; ++i)
     {
@@ -100,18 +111,20 @@ size_t SparseHoughSpace::evictWeakest(size_t max_chunks)
   strength.reserve(allocated_.size());
   for (int chunk_index : allocated_)
   {
-    const float* chunk = chunks_[chunk_index].get();
+    const float* chunk = chunkData(chunk_index);
     strength.emplace_back(*std::max_element(chunk, chunk + kChunkCells), chunk_index);
   }
   const size_t evicted = allocated_.size() - max_chunks;
   std::nth_element(strength.begin(), strength.begin() + evicted, strength.end());
-  std::vector<char> drop(chunks_.size(), 0);
-  for (size_t i = 0; i < evicted; ++i) drop[strength[i].second] = 1;
+  std::vector<int> drop;
+  drop.reserve(evicted);
+  for (size_t i = 0; i < evicted; ++i) drop.push_back(strength[i].second);
+  std::sort(drop.begin(), drop.end());
   std::vector<int> kept;
   kept.reserve(max_chunks);
   for (int chunk_index : allocated_)
   {
-    if (drop[chunk_index])
+    if (std::binary_search(drop.begin(), drop.end(), chunk_index))
       release(chunk_index);
     else
       kept.push_back(chunk_index);
@@ -130,14 +143,15 @@ void SparseHoughSpace::release(int chunk_index)
 {
   // A small pool spares the per-frame space a malloc per chunk; beyond it memory goes back.
   if (pool_.size() < kMaxPooledChunks)
-    pool_.push_back(std::move(chunks_[chunk_index]));
+    pool_.push_back(std::move(slot(chunk_index)));
   else
-    chunks_[chunk_index].reset();
+    slot(chunk_index).reset();
 }
 
 size_t SparseHoughSpace::bytesUsed() const
 {
-  return chunks_.size() * sizeof(chunks_[0]) + allocated_.size() * (sizeof(float) * kChunkCells + sizeof(int));
+  return slabs_.size() * sizeof(Slab) + slab_count_ * static_cast<size_t>(chunks_x_) * chunks_y_ * sizeof(std::unique_ptr<float[]>) +
+         allocated_.size() * (sizeof(float) * kChunkCells + sizeof(int));
 }
 
 size_t SparseHoughSpace::denseBytes() const

@@ -380,6 +380,8 @@ void PlaneDetectorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no cloud processed yet");
   else if (memory.chunks_evicted_total > 0)
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "the max_chunks cap freed Hough chunks");
+  else if (detector_->lastStats().votes_out_of_range > 0)
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "planes beyond max_distance are not represented");
   else if (frames_dropped_ + frames_rejected_ + frames_queue_dropped_ > 0)
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "some clouds were skipped");
   else
@@ -396,6 +398,7 @@ void PlaneDetectorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("Hough space % of dense", 100.0 * memory.global_bytes / std::max<size_t>(1, memory.dense_bytes));
   status.add("Hough chunks", memory.global_chunks);
   status.add("Hough chunks freed by max_chunks", memory.chunks_evicted_total);
+  status.add("votes beyond max_distance (last frame)", detector_->lastStats().votes_out_of_range);
   const HoughParameterization& grid = detector_->parameterization();
   status.addf("Hough grid", "resolution %d: %d x %d x %d cells", params_.resolution, grid.sizeAngle(), grid.sizeAngle(),
               grid.sizeD());

@@ -51,7 +51,7 @@ struct DetectorParams
   // Step of the d axis in metres when resolution == 0.
   double d_step = 0.0097;
   // |d| range of the world-frame Hough space in metres; planes farther from the origin are ignored.
-  double max_distance = 10.0;
+  double max_distance = 100.0;
 
   // Gaussian blur of the per-frame space and of each global contribution, in cells.
   double blur_sigma = 1.0;

@@ -1,5 +1,7 @@
 // The paper's 2-level Hough space (3.3.1): a top grid of pointers to 16^3-cell chunks that are
-// allocated on first write and freed when they become empty.
+// allocated on first write and freed when they become empty. The top grid itself is allocated
+// by slabs of one chunk layer in d as they are first written, so a space reaching far in d
+// (a building-scale max_distance) costs memory only where planes are.
 #pragma once
 
 #include <cstddef>
@@ -32,7 +34,9 @@ public:
   float value(int x, int y, int z) const
   {
     if (!inBounds(x, y, z)) return 0.0f;
-    const float* chunk = chunks_[chunkIndex(x, y, z)].get();
+    const Slab& slab = slabs_[z >> kChunkBits];
+    if (!slab) return 0.0f;
+    const float* chunk = slab[column(x, y)].get();
     return chunk ? chunk[cellIndex(x, y, z)] : 0.0f;
   }
   void add(int x, int y, int z, float v);
@@ -51,8 +55,9 @@ public:
   void clear();
 
   size_t chunkCount() const { return allocated_.size(); }
-  size_t topLevelCount() const { return chunks_.size(); }
-  // Bytes held by the top grid and the allocated chunks (the reuse pool is reported apart).
+  // Chunk indices run over [0, topLevelCount()).
+  size_t topLevelCount() const { return static_cast<size_t>(chunks_x_) * chunks_y_ * chunks_z_; }
+  // Bytes held by the top grid's allocated slabs and the chunks (the reuse pool is reported apart).
   size_t bytesUsed() const;
   size_t bytesPooled() const { return pool_.size() * sizeof(float) * kChunkCells; }
   // Bytes a dense float array of the same size would need.
@@ -64,7 +69,7 @@ public:
   {
     for (int chunk_index : allocated_)
     {
-      const float* chunk = chunks_[chunk_index].get();
+      const float* chunk = chunkData(chunk_index);
       const int cz = chunk_index % chunks_z_, cy = (chunk_index / chunks_z_) % chunks_y_,
                 cx = chunk_index / (chunks_z_ * chunks_y_);
       for (int i = 0; i < kChunkCells; ++i)
@@ -78,16 +83,21 @@ public:
 
   // Raw chunk access for saving and loading maps.
   const std::vector<int>& allocatedChunkIndices() const { return allocated_; }
-  const float* chunkData(int chunk_index) const { return chunks_[chunk_index].get(); }
+  const float* chunkData(int chunk_index) const
+  {
+    const Slab& slab = slabs_[chunk_index % chunks_z_];
+    return slab ? slab[chunk_index / chunks_z_].get() : nullptr;
+  }
   float* allocateChunk(int chunk_index);
 
 private:
+  // One chunk layer in d: a pointer per (x, y) chunk column.
+  using Slab = std::unique_ptr<std::unique_ptr<float[]>[]>;
   static constexpr size_t kMaxPooledChunks = 256;
   void release(int chunk_index);
-  int chunkIndex(int x, int y, int z) const
-  {
-    return ((x >> kChunkBits) * chunks_y_ + (y >> kChunkBits)) * chunks_z_ + (z >> kChunkBits);
-  }
+  std::unique_ptr<float[]>& slot(int chunk_index);
+  int column(int x, int y) const { return (x >> kChunkBits) * chunks_y_ + (y >> kChunkBits); }
+  int chunkIndex(int x, int y, int z) const { return column(x, y) * chunks_z_ + (z >> kChunkBits); }
   static int cellIndex(int x, int y, int z)
   {
     constexpr int m = kChunkEdge - 1;
@@ -96,7 +106,8 @@ private:
 
   int size_x_, size_y_, size_z_;
   int chunks_x_, chunks_y_, chunks_z_;
-  std::vector<std::unique_ptr<float[]>> chunks_;
+  std::vector<Slab> slabs_;  // chunks_z_ of them, allocated on first write
+  size_t slab_count_ = 0;
   std::vector<int> allocated_;
   std::vector<std::unique_ptr<float[]>> pool_;
 };
