@@ -30,9 +30,13 @@ TEST(SparseHoughSpace, ReportsMemoryAgainstTheDenseArray)
   const size_t empty = space.bytesUsed();
   EXPECT_EQ(space.denseBytes(), size_t(530) * 530 * 2052 * sizeof(float));
   space.add(100, 100, 100, 1.0f);
-  EXPECT_EQ(space.bytesUsed() - empty, SparseHoughSpace::kChunkCells * sizeof(float) + sizeof(int));
-  // The top grid alone is far below 1 % of the dense array.
-  EXPECT_LT(static_cast<double>(empty) / space.denseBytes(), 0.001);
+  const size_t chunk = SparseHoughSpace::kChunkCells * sizeof(float) + sizeof(int);
+  const size_t slab = ((530 + 15) / 16) * ((530 + 15) / 16) * sizeof(void*);  // the top grid's layer of d
+  EXPECT_EQ(space.bytesUsed() - empty, chunk + slab);
+  space.add(300, 200, 100, 1.0f);  // another chunk of the same d layer: no new slab
+  EXPECT_EQ(space.bytesUsed() - empty, 2 * chunk + slab);
+  // The empty top grid is far below 0.01 % of the dense array.
+  EXPECT_LT(static_cast<double>(empty) / space.denseBytes(), 0.0001);
 }
 
 TEST(SparseHoughSpace, SeparableAddAcrossChunkBordersMatchesTheOuterProduct)
