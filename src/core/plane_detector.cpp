@@ -179,6 +179,8 @@ std::vector<std::vector<Eigen::Vector3d>> PlaneDetector::regions(const DetectedP
   return map_.regions(plane);
 }
 
+std::vector<PlaneOutline> PlaneDetector::outlines(const DetectedPlane& plane) const { return map_.outlines(plane); }
+
 std::vector<Eigen::Vector3d> PlaneDetector::hull(const DetectedPlane& plane) const { return map_.hull(plane); }
 
 void PlaneDetector::labelPixels(const CloudView& cloud, std::vector<int>& labels) const

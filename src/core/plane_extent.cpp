@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <climits>
+#include <cstdint>
 
 namespace hough_plane_detector
 {
@@ -59,46 +61,269 @@ std::vector<Eigen::Vector3d> PlaneExtent::hull(int64_t frame, float fade) const
   return hullOf(live);
 }
 
-std::vector<std::vector<Eigen::Vector3d>> PlaneExtent::regions(int64_t frame, float fade) const
+std::vector<std::vector<std::pair<int32_t, int32_t>>> PlaneExtent::connectedRegions(int64_t frame, float fade) const
 {
   // Live cells within kRegionGap cells of each other are one region: far blocks mark cells a
   // few centimetres apart, while two tables or two rooms' floors lie metres apart.
   constexpr int32_t kRegionGap = 2;
   constexpr size_t kMinRegionCells = 4;
-  std::unordered_map<uint64_t, int> label;  // live cell -> region (-1: not yet visited)
+  constexpr int64_t kMaxDenseCells = 1 << 20;  // a dense label grid up to 50 m x 50 m of plane
+  std::vector<std::pair<int32_t, int32_t>> live;
+  int32_t x_min = INT32_MAX, y_min = INT32_MAX, x_max = INT32_MIN, y_max = INT32_MIN;
   for (const auto& cell : cells_)
-    if (weightAt(cell.second, frame, fade) > 0.0f) label.emplace(cell.first, -1);
-  std::vector<std::vector<Eigen::Vector3d>> out;
-  std::vector<std::pair<int32_t, int32_t>> region, queue;
-  int next = 0;
-  for (auto& seed : label)
+    if (weightAt(cell.second, frame, fade) > 0.0f)
+    {
+      const int32_t x = static_cast<int32_t>(cell.first >> 32), y = static_cast<int32_t>(cell.first & 0xffffffffu);
+      live.emplace_back(x, y);
+      x_min = std::min(x_min, x), x_max = std::max(x_max, x), y_min = std::min(y_min, y), y_max = std::max(y_max, y);
+    }
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> out;
+  if (live.empty()) return out;
+  std::sort(live.begin(), live.end());  // regions independent of the hash map's order
+  const int64_t w = int64_t(x_max) - x_min + 1, h = int64_t(y_max) - y_min + 1;
+  // label[i] of live[i]; a dense index of the live cells when the extent is compact.
+  std::vector<int> label(live.size(), -1);
+  std::vector<int32_t> dense;
+  std::unordered_map<uint64_t, int32_t> sparse;
+  const bool use_dense = w * h <= kMaxDenseCells;
+  if (use_dense)
   {
-    if (seed.second >= 0) continue;
-    seed.second = next;
-    queue.assign(1, {static_cast<int32_t>(seed.first >> 32), static_cast<int32_t>(seed.first & 0xffffffffu)});
-    region.clear();
+    dense.assign(static_cast<size_t>(w * h), -1);
+    for (size_t i = 0; i < live.size(); ++i)
+      dense[static_cast<size_t>((live[i].second - y_min) * w + (live[i].first - x_min))] = static_cast<int32_t>(i);
+  }
+  else
+    for (size_t i = 0; i < live.size(); ++i) sparse.emplace(key(live[i].first, live[i].second), static_cast<int32_t>(i));
+  auto find = [&](int32_t x, int32_t y) -> int32_t {
+    if (use_dense)
+    {
+      if (x < x_min || x > x_max || y < y_min || y > y_max) return -1;
+      return dense[static_cast<size_t>((int64_t(y) - y_min) * w + (int64_t(x) - x_min))];
+    }
+    const auto it = sparse.find(key(x, y));
+    return it == sparse.end() ? -1 : it->second;
+  };
+  std::vector<int32_t> queue;
+  int next = 0;
+  for (size_t seed = 0; seed < live.size(); ++seed)
+  {
+    if (label[seed] >= 0) continue;
+    label[seed] = next;
+    queue.assign(1, static_cast<int32_t>(seed));
+    std::vector<std::pair<int32_t, int32_t>> region;
     while (!queue.empty())
     {
-      const auto c = queue.back();
+      const auto c = live[queue.back()];
       queue.pop_back();
       region.push_back(c);
       for (int32_t dx = -kRegionGap; dx <= kRegionGap; ++dx)
         for (int32_t dy = -kRegionGap; dy <= kRegionGap; ++dy)
         {
-          const auto it = label.find(key(c.first + dx, c.second + dy));
-          if (it == label.end() || it->second >= 0) continue;
-          it->second = next;
-          queue.emplace_back(c.first + dx, c.second + dy);
+          const int32_t j = find(c.first + dx, c.second + dy);
+          if (j < 0 || label[j] >= 0) continue;
+          label[j] = next;
+          queue.push_back(j);
         }
     }
     ++next;
-    if (region.size() >= kMinRegionCells) out.push_back(hullOf(region));
+    if (region.size() >= kMinRegionCells) out.push_back(std::move(region));
   }
+  return out;
+}
+
+std::vector<std::vector<Eigen::Vector3d>> PlaneExtent::regions(int64_t frame, float fade) const
+{
+  std::vector<std::vector<Eigen::Vector3d>> out;
+  for (const auto& region : connectedRegions(frame, fade)) out.push_back(hullOf(region));
   // Largest first, so that the order does not depend on the hash map's.
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
     return a.size() != b.size() ? a.size() > b.size() : a.front().x() < b.front().x();
   });
   return out;
+}
+
+std::vector<PlaneOutline> PlaneExtent::outlines(int64_t frame, float fade) const
+{
+  std::vector<PlaneOutline> out;
+  for (const auto& region : connectedRegions(frame, fade))
+  {
+    const std::vector<Eigen::Vector3d> hull = hullOf(region);
+    for (PlaneOutline& outline : outlinesOf(region))
+    {
+      outline.hull = hull;
+      out.push_back(std::move(outline));
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const PlaneOutline& a, const PlaneOutline& b) { return a.area > b.area; });
+  return out;
+}
+
+std::vector<PlaneOutline> PlaneExtent::outlinesOf(const std::vector<std::pair<int32_t, int32_t>>& region) const
+{
+  if (!basis_ || region.empty()) return {};
+  // Shapes are traced on a 10 cm grid (2 x 2 cells), closed (dilate, then erode, 3 x 3): far
+  // blocks mark cells a few centimetres apart, which the regions bridge and the shape must not
+  // show as a lattice of holes; holes and concave corners of 10 cm and more remain.
+  constexpr int32_t kCoarse = 2;
+  constexpr double kShapeCell = kCoarse * kCellSize;
+  auto coarse = [](int32_t v) { return v >= 0 ? v / kCoarse : -((-v + kCoarse - 1) / kCoarse); };
+  int32_t x_min = INT32_MAX, y_min = INT32_MAX, x_max = INT32_MIN, y_max = INT32_MIN;
+  for (const auto& c : region)
+  {
+    x_min = std::min(x_min, coarse(c.first)), x_max = std::max(x_max, coarse(c.first));
+    y_min = std::min(y_min, coarse(c.second)), y_max = std::max(y_max, coarse(c.second));
+  }
+  // A dense grid over the region with a margin of 2: dilation reaches 1 beyond, the boundary 1 more.
+  const int32_t x0 = x_min - 2, y0 = y_min - 2, w = x_max - x_min + 5, h = y_max - y_min + 5;
+  std::vector<uint8_t> marked(static_cast<size_t>(w) * h, 0), dilated(marked.size(), 0), closed(marked.size(), 0);
+  auto at = [w](int32_t x, int32_t y) { return static_cast<size_t>(y) * w + x; };
+  for (const auto& c : region) marked[at(coarse(c.first) - x0, coarse(c.second) - y0)] = 1;
+  for (int32_t y = 1; y + 1 < h; ++y)
+    for (int32_t x = 1; x + 1 < w; ++x)
+      if (marked[at(x, y)])
+        for (int32_t dy = -1; dy <= 1; ++dy)
+          for (int32_t dx = -1; dx <= 1; ++dx) dilated[at(x + dx, y + dy)] = 1;
+  for (int32_t y = 1; y + 1 < h; ++y)
+    for (int32_t x = 1; x + 1 < w; ++x)
+    {
+      bool inside = true;
+      for (int32_t dy = -1; dy <= 1 && inside; ++dy)
+        for (int32_t dx = -1; dx <= 1 && inside; ++dx) inside = dilated[at(x + dx, y + dy)] != 0;
+      closed[at(x, y)] = inside || marked[at(x, y)];
+    }
+  // Boundary edges with the region on their left (counter-clockwise around each cell), at most
+  // two leaving any grid vertex; chained into loops: outer boundaries turn counter-clockwise,
+  // holes clockwise.
+  const int32_t vw = w + 1;
+  std::vector<std::array<int32_t, 2>> out_edges(static_cast<size_t>(vw) * (h + 1), {-1, -1});
+  size_t edge_count = 0;
+  auto addEdge = [&](int32_t fx, int32_t fy, int32_t tx, int32_t ty) {
+    auto& slots = out_edges[static_cast<size_t>(fy) * vw + fx];
+    slots[slots[0] < 0 ? 0 : 1] = ty * vw + tx;
+    ++edge_count;
+  };
+  auto in = [&](int32_t x, int32_t y) { return x >= 0 && y >= 0 && x < w && y < h && closed[at(x, y)]; };
+  for (int32_t y = 0; y < h; ++y)
+    for (int32_t x = 0; x < w; ++x)
+    {
+      if (!closed[at(x, y)]) continue;
+      if (!in(x, y - 1)) addEdge(x, y, x + 1, y);
+      if (!in(x + 1, y)) addEdge(x + 1, y, x + 1, y + 1);
+      if (!in(x, y + 1)) addEdge(x + 1, y + 1, x, y + 1);
+      if (!in(x - 1, y)) addEdge(x, y + 1, x, y);
+    }
+  std::vector<std::vector<Eigen::Vector2d>> outers, holes;
+  std::vector<double> outer_areas;
+  auto point = [&](int32_t v) { return Eigen::Vector2d((v % vw + x0) * kShapeCell, (v / vw + y0) * kShapeCell); };
+  for (size_t start = 0; start < out_edges.size() && edge_count > 0; ++start)
+    while (out_edges[start][0] >= 0)
+    {
+      std::vector<int32_t> loop;
+      int32_t v = static_cast<int32_t>(start), previous = -1;
+      do
+      {
+        auto& slots = out_edges[v];
+        int chosen = slots[0] >= 0 ? 0 : 1;
+        // Where two loops touch at a corner, keep to the left turn: each loop stays simple.
+        if (slots[0] >= 0 && slots[1] >= 0 && previous >= 0)
+        {
+          const int32_t dx = v % vw - previous % vw, dy = v / vw - previous / vw;
+          const int32_t ex = slots[1] % vw - v % vw, ey = slots[1] / vw - v / vw;
+          if (dx * ey - dy * ex > 0) chosen = 1;
+        }
+        loop.push_back(v);
+        previous = v;
+        const int32_t next = slots[chosen];
+        slots[chosen] = -1;
+        if (chosen == 0) std::swap(slots[0], slots[1]);  // keep a remaining edge in slot 0
+        --edge_count;
+        v = next;
+      } while (v != static_cast<int32_t>(start) && (out_edges[v][0] >= 0 || out_edges[v][1] >= 0));
+      // Corners only: drop vertices between collinear edges.
+      std::vector<Eigen::Vector2d> polygon;
+      for (size_t i = 0; i < loop.size(); ++i)
+      {
+        const Eigen::Vector2d p = point(loop[(i + loop.size() - 1) % loop.size()]), c = point(loop[i]),
+                              n = point(loop[(i + 1) % loop.size()]);
+        const Eigen::Vector2d d1 = c - p, d2 = n - c;
+        if (std::abs(d1.x() * d2.y() - d1.y() * d2.x()) < 1e-12) continue;
+        polygon.push_back(c);
+      }
+      if (polygon.size() < 3) continue;
+      double area = 0.0;
+      for (size_t i = 0; i < polygon.size(); ++i)
+      {
+        const Eigen::Vector2d& p = polygon[i];
+        const Eigen::Vector2d& q = polygon[(i + 1) % polygon.size()];
+        area += 0.5 * (p.x() * q.y() - q.x() * p.y());
+      }
+      if (area > 0.0)
+      {
+        outers.push_back(polygon);
+        outer_areas.push_back(area);
+      }
+      else
+        holes.push_back(polygon);
+    }
+  // Each hole belongs to the outer boundary around it (even-odd test of a point inside it).
+  auto contains = [](const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& q) {
+    bool inside = false;
+    for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
+      if ((polygon[i].y() > q.y()) != (polygon[j].y() > q.y()) &&
+          q.x() < (polygon[j].x() - polygon[i].x()) * (q.y() - polygon[i].y()) / (polygon[j].y() - polygon[i].y()) + polygon[i].x())
+        inside = !inside;
+    return inside;
+  };
+  auto lift = [this](const std::vector<Eigen::Vector2d>& polygon) {
+    std::vector<Eigen::Vector3d> lifted;
+    for (const Eigen::Vector2d& q : polygon) lifted.push_back(basis_->lift(q));
+    return lifted;
+  };
+  std::vector<PlaneOutline> shapes(outers.size());
+  for (size_t o = 0; o < outers.size(); ++o)
+  {
+    shapes[o].boundary = lift(outers[o]);
+    shapes[o].area = outer_areas[o];
+  }
+  for (const auto& hole : holes)
+  {
+    double area = 0.0;  // negative: clockwise
+    for (size_t i = 0; i < hole.size(); ++i)
+      area += 0.5 * (hole[i].x() * hole[(i + 1) % hole.size()].y() - hole[(i + 1) % hole.size()].x() * hole[i].y());
+    // Just right of the hole's first edge, inside the hole (which is on the right of a clockwise loop).
+    const Eigen::Vector2d edge = hole[1] - hole[0];
+    const Eigen::Vector2d q = 0.5 * (hole[0] + hole[1]) + 0.25 * kShapeCell * Eigen::Vector2d(edge.y(), -edge.x()).normalized();
+    for (size_t o = 0; o < outers.size(); ++o)
+      if (contains(outers[o], q))
+      {
+        shapes[o].holes.push_back(lift(hole));
+        shapes[o].area += area;
+        break;
+      }
+  }
+  // Rows of the closed grid as rectangles, each given to the outer boundary around it.
+  for (int32_t y = 0; y < h; ++y)
+    for (int32_t x = 0; x < w;)
+    {
+      if (!closed[at(x, y)])
+      {
+        ++x;
+        continue;
+      }
+      int32_t end = x;
+      while (end + 1 < w && closed[at(end + 1, y)]) ++end;
+      const double ax = (x + x0) * kShapeCell, bx = (end + 1 + x0) * kShapeCell;
+      const double ay = (y + y0) * kShapeCell, by = (y + 1 + y0) * kShapeCell;
+      const Eigen::Vector2d centre(0.5 * (ax + bx), 0.5 * (ay + by));
+      for (size_t o = 0; o < outers.size(); ++o)
+        if (contains(outers[o], centre))
+        {
+          shapes[o].fill.push_back({basis_->lift({ax, ay}), basis_->lift({bx, ay}), basis_->lift({bx, by}), basis_->lift({ax, by})});
+          break;
+        }
+      x = end + 1;
+    }
+  return shapes;
 }
 
 std::vector<Eigen::Vector3d> PlaneExtent::hullOf(const std::vector<std::pair<int32_t, int32_t>>& live) const

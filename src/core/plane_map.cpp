@@ -260,6 +260,12 @@ std::vector<std::vector<Eigen::Vector3d>> PlaneMap::regions(const DetectedPlane&
   return e ? e->regions(frame_count_, extentFade()) : std::vector<std::vector<Eigen::Vector3d>>();
 }
 
+std::vector<PlaneOutline> PlaneMap::outlines(const DetectedPlane& plane) const
+{
+  const PlaneExtent* e = extent(plane.id);
+  return e ? e->outlines(frame_count_, extentFade()) : std::vector<PlaneOutline>();
+}
+
 std::vector<Eigen::Vector3d> PlaneMap::hull(const DetectedPlane& plane) const
 {
   const PlaneExtent* e = extent(plane.id);

@@ -269,9 +269,12 @@ void PlaneDetectorRos::publishMap()
   for (const DetectedPlane& p : detector_->planes())
   {
     const std::vector<Eigen::Vector3d> hull = detector_->hull(p);
-    const std::vector<std::vector<Eigen::Vector3d>> regions = detector_->regions(p);
-    planes->planes.push_back(toPlaneMsg(p, hull, regions));
-    appendPlaneMarkers(header, p, regions, markers->markers);
+    // One pass over the extent's cells for both: each shape carries its region's hull.
+    const std::vector<PlaneOutline> outlines = detector_->outlines(p);
+    std::vector<std::vector<Eigen::Vector3d>> regions;
+    for (const PlaneOutline& outline : outlines) regions.push_back(outline.hull);
+    planes->planes.push_back(toPlaneMsg(p, hull, regions, outlines));
+    appendPlaneMarkers(header, p, outlines, markers->markers);
   }
   planes_pub_.publish(planes);
   markers_pub_.publish(markers);

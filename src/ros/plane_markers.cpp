@@ -28,7 +28,7 @@ geometry_msgs::Polygon toPolygon(const std::vector<Eigen::Vector3d>& vertices)
 }  // namespace
 
 Plane toPlaneMsg(const DetectedPlane& plane, const std::vector<Eigen::Vector3d>& hull,
-                 const std::vector<std::vector<Eigen::Vector3d>>& regions)
+                 const std::vector<std::vector<Eigen::Vector3d>>& regions, const std::vector<PlaneOutline>& outlines)
 {
   Plane msg;
   msg.id = plane.id;
@@ -45,6 +45,14 @@ Plane toPlaneMsg(const DetectedPlane& plane, const std::vector<Eigen::Vector3d>&
   msg.last_seen.fromSec(plane.last_seen);
   msg.hull = toPolygon(hull);
   for (const auto& region : regions) msg.regions.push_back(toPolygon(region));
+  for (const PlaneOutline& outline : outlines)
+  {
+    PlaneShape shape;
+    shape.outline = toPolygon(outline.boundary);
+    for (const auto& hole : outline.holes) shape.holes.push_back(toPolygon(hole));
+    shape.area = outline.area;
+    msg.outlines.push_back(shape);
+  }
   return msg;
 }
 
@@ -103,38 +111,34 @@ visualization_msgs::Marker baseMarker(const std_msgs::Header& header, const char
 }
 }  // namespace
 
-void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane,
-                        const std::vector<std::vector<Eigen::Vector3d>>& regions,
+void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane, const std::vector<PlaneOutline>& outlines,
                         std::vector<visualization_msgs::Marker>& markers)
 {
-  if (regions.empty() || regions.front().size() < 3) return;  // not seen enough yet to have an extent
-  auto centreOf = [](const std::vector<Eigen::Vector3d>& polygon) {
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const auto& v : polygon) centre += v;
-    return Eigen::Vector3d(centre / static_cast<double>(polygon.size()));
-  };
-  const Eigen::Vector3d centre = centreOf(regions.front());  // of the largest region
+  if (outlines.empty() || outlines.front().boundary.size() < 3) return;  // not seen enough yet to have an extent
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // of the largest region's outline
+  for (const auto& v : outlines.front().boundary) centre += v;
+  centre /= static_cast<double>(outlines.front().boundary.size());
 
-  // One patch and one outline marker per plane, covering all its regions.
+  // One patch and one outline marker per plane, covering all its regions: the regions' rows of
+  // cells as quads (holes stay open), their outlines and holes as lines.
   visualization_msgs::Marker patch = baseMarker(header, "patches", plane.id, visualization_msgs::Marker::TRIANGLE_LIST);
   patch.color = colourForId(plane.id, 0.45f);
   visualization_msgs::Marker outline = baseMarker(header, "outlines", plane.id, visualization_msgs::Marker::LINE_LIST);
   outline.scale.x = 0.02;
   outline.color = colourForId(plane.id, 1.0f);
-  for (const std::vector<Eigen::Vector3d>& hull : regions)
-  {
-    if (hull.size() < 3) continue;
-    const Eigen::Vector3d middle = centreOf(hull);
-    for (size_t i = 0; i < hull.size(); ++i)  // each region's hull is convex: a fan around its centre
+  auto addLoop = [&](const std::vector<Eigen::Vector3d>& loop) {
+    for (size_t i = 0; i < loop.size(); ++i)
     {
-      const Eigen::Vector3d& a = hull[i];
-      const Eigen::Vector3d& b = hull[(i + 1) % hull.size()];
-      patch.points.push_back(toPoint(middle));
-      patch.points.push_back(toPoint(a));
-      patch.points.push_back(toPoint(b));
-      outline.points.push_back(toPoint(a));
-      outline.points.push_back(toPoint(b));
+      outline.points.push_back(toPoint(loop[i]));
+      outline.points.push_back(toPoint(loop[(i + 1) % loop.size()]));
     }
+  };
+  for (const PlaneOutline& region : outlines)
+  {
+    for (const auto& quad : region.fill)
+      for (int corner : {0, 1, 2, 0, 2, 3}) patch.points.push_back(toPoint(quad[corner]));
+    addLoop(region.boundary);
+    for (const auto& hole : region.holes) addLoop(hole);
   }
   markers.push_back(patch);
   markers.push_back(outline);

@@ -114,6 +114,8 @@ public:
   std::vector<Eigen::Vector3d> hull(const DetectedPlane& plane) const;
   // Convex hull of each connected region of the plane's extent, largest first (PlaneExtent::regions).
   std::vector<std::vector<Eigen::Vector3d>> regions(const DetectedPlane& plane) const;
+  // The shape of each connected region: concave outline, holes, fill (PlaneExtent::outlines).
+  std::vector<PlaneOutline> outlines(const DetectedPlane& plane) const;
 
   // Parameters that keep the Hough grid (everything but resolution, angle_step, d_step,
   // max_distance, blur_kernel_size, peak_window) change in place; returns false, changing

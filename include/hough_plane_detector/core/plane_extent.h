@@ -3,6 +3,7 @@
 // hull as the polygon markers and messages show.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -28,6 +29,19 @@ struct PlaneBasis
   Eigen::Vector3d origin, u, v;
 };
 
+// The shape of one connected region of a plane's extent, world frame: its outline, concave
+// where the region is, counter-clockwise about the plane's normal, and its holes (where a
+// pillar stands), clockwise; `fill` covers the region with rectangles (4 corners each), rows
+// of cells merged, for filled markers.
+struct PlaneOutline
+{
+  std::vector<Eigen::Vector3d> hull;  // convex hull of its region (as regions() gives it)
+  std::vector<Eigen::Vector3d> boundary;
+  std::vector<std::vector<Eigen::Vector3d>> holes;
+  std::vector<std::array<Eigen::Vector3d, 4>> fill;
+  double area = 0.0;  // m^2, holes excluded
+};
+
 class PlaneExtent
 {
 public:
@@ -48,6 +62,9 @@ public:
   // regions of fewer than 4 cells are left out), largest first: two tables at one height, or
   // two rooms' floors, are two regions of one plane.
   std::vector<std::vector<Eigen::Vector3d>> regions(int64_t frame, float fade_per_frame) const;
+  // The regions' shapes (the same regions) on a 10 cm grid, gaps of one grid cell closed,
+  // largest first.
+  std::vector<PlaneOutline> outlines(int64_t frame, float fade_per_frame) const;
   size_t cellCount() const { return cells_.size(); }
   // Calls f(centre) with the world-frame centre of every live cell (unordered) whose
   // coordinates are multiples of `every` (2: a 10 cm lattice).
@@ -82,6 +99,10 @@ private:
   }
   static float weightAt(const Cell& c, int64_t frame, float fade) { return c.weight - fade * (frame - c.seen); }
   std::vector<Eigen::Vector3d> hullOf(const std::vector<std::pair<int32_t, int32_t>>& cells) const;
+  // Live cells grouped into connected regions (cells up to kRegionGap apart), each of at least
+  // kMinRegionCells cells.
+  std::vector<std::vector<std::pair<int32_t, int32_t>>> connectedRegions(int64_t frame, float fade) const;
+  std::vector<PlaneOutline> outlinesOf(const std::vector<std::pair<int32_t, int32_t>>& region) const;
   std::unordered_map<uint64_t, Cell> cells_;
   std::shared_ptr<const PlaneBasis> basis_;
 };

@@ -56,6 +56,7 @@ public:
   const PlaneExtent* extent(int id) const;
   std::vector<Eigen::Vector3d> hull(const DetectedPlane& plane) const;
   std::vector<std::vector<Eigen::Vector3d>> regions(const DetectedPlane& plane) const;
+  std::vector<PlaneOutline> outlines(const DetectedPlane& plane) const;
   void clear();
 
   // Versioned bytes with the grid they were built on and a checksum (map_file.cpp).

@@ -20,16 +20,15 @@ namespace hough_plane_detector
 
 // A map plane with its extent's hull and regions (world frame) as a Plane message.
 Plane toPlaneMsg(const DetectedPlane& plane, const std::vector<Eigen::Vector3d>& hull,
-                 const std::vector<std::vector<Eigen::Vector3d>>& regions);
+                 const std::vector<std::vector<Eigen::Vector3d>>& regions, const std::vector<PlaneOutline>& outlines);
 // A stable, well-spread colour per plane id (golden-ratio hues).
 std_msgs::ColorRGBA colourForId(int id, float alpha);
 // DELETEALL, sent first in every array so that no marker of a vanished plane stays.
 visualization_msgs::Marker deleteAllMarker(const std_msgs::Header& header);
-// Per plane: filled patches of its regions (TRIANGLE_LIST, ns "patches"), their outlines
-// (LINE_LIST, "outlines"), normal (ARROW, "normals") and id label (TEXT_VIEW_FACING, "labels")
-// at its largest region; marker id = plane id.
-void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane,
-                        const std::vector<std::vector<Eigen::Vector3d>>& regions,
+// Per plane: its regions filled (TRIANGLE_LIST, ns "patches"; holes left open), their outlines
+// and holes (LINE_LIST, "outlines"), normal (ARROW, "normals") and id label (TEXT_VIEW_FACING,
+// "labels") at its largest region; marker id = plane id.
+void appendPlaneMarkers(const std_msgs::Header& header, const DetectedPlane& plane, const std::vector<PlaneOutline>& outlines,
                         std::vector<visualization_msgs::Marker>& markers);
 // Label of a point on no plane in the segmented cloud (uint32, as PCL's PointXYZRGBL).
 constexpr uint32_t kNoPlaneLabel = 0xFFFFFFFFu;
