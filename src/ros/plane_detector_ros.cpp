@@ -16,23 +16,19 @@ namespace hough_plane_detector
 
 namespace
 {
-HoughPlaneDetectorConfig toConfig(const DetectorParams& from)
+// The .cfg declares the same names as the core's parameter list: one copy serves both ways.
+template <class To, class From>
+To copyParams(const From& from)
 {
-  HoughPlaneDetectorConfig to;
+  To to;
 #define HPD_COPY(type, name) to.name = from.name;
   HOUGH_PLANE_DETECTOR_PARAMS(HPD_COPY)
 #undef HPD_COPY
   return to;
 }
 
-DetectorParams toParams(const HoughPlaneDetectorConfig& from)
-{
-  DetectorParams to;
-#define HPD_COPY(type, name) to.name = from.name;
-  HOUGH_PLANE_DETECTOR_PARAMS(HPD_COPY)
-#undef HPD_COPY
-  return to;
-}
+HoughPlaneDetectorConfig toConfig(const DetectorParams& from) { return copyParams<HoughPlaneDetectorConfig>(from); }
+DetectorParams toParams(const HoughPlaneDetectorConfig& from) { return copyParams<DetectorParams>(from); }
 }  // namespace
 
 PlaneDetectorRos::~PlaneDetectorRos()
