@@ -13,7 +13,6 @@ namespace
 constexpr double kMaxParallelCentroidSigma = 0.3;  // of support_distance
 constexpr double kMinParallelGrazingSine = 0.1;    // rays at least ~6 deg to the plane
 
-
 struct KnownPlane
 {
   Eigen::Vector3d normal, normal_cam;
