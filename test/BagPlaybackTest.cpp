@@ -7,6 +7,7 @@
 #include <ros/ros.h>
 
 #include "hough_plane_detector/PlaneArray.h"
+#include "plane_array_helpers.h"
 #include "test_bags.h"
 
 using namespace hough_plane_detector;
@@ -34,19 +35,13 @@ TEST(BagPlayback, NodeletOnAPlayedBagMatchesTheOfflineTool)
   const auto& expected = expected_frames.back();
   ASSERT_GE(expected.size(), 3u) << offline;
 
-  std::mutex mutex;
-  std::vector<PlaneArray::ConstPtr> received;
-  ros::NodeHandle nh;
-  ros::Subscriber sub = nh.subscribe<PlaneArray>("/hough_plane_detector/planes", 100, [&](const PlaneArray::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    received.push_back(m);
-  });
+  PlaneArrayRecorder recorder;
   ros::WallDuration(2.0).sleep();  // let the subscription connect
   const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 1 " + bag, &code);
   ASSERT_EQ(code, 0) << played;
   ros::WallDuration(2.0).sleep();
 
-  std::lock_guard<std::mutex> lock(mutex);
+  const std::vector<PlaneArray::ConstPtr> received = recorder.received();
   std::string stamps;
   for (const auto& m : received) stamps += " " + std::to_string(m->header.stamp.toSec());
   ASSERT_EQ(received.size(), static_cast<size_t>(frames)) << "every played cloud gives one plane array; got" << stamps;

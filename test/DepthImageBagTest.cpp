@@ -9,6 +9,7 @@
 #include <ros/ros.h>
 
 #include "hough_plane_detector/PlaneArray.h"
+#include "plane_array_helpers.h"
 #include "test_bags.h"
 
 using namespace hough_plane_detector;
@@ -20,20 +21,14 @@ TEST(DepthImage, ATumStyleBagGivesTheRoomsPlanes)
   const std::string bag = "/tmp/hough_plane_detector_tum_style.bag";
   const std::vector<TruePlane> truth = writeTumBag(bag, kTumFrames);
 
-  std::mutex mutex;
-  std::vector<PlaneArray::ConstPtr> received;
-  ros::NodeHandle nh;
-  ros::Subscriber sub = nh.subscribe<PlaneArray>("/hough_plane_detector/planes", 100, [&](const PlaneArray::ConstPtr& m) {
-    std::lock_guard<std::mutex> lock(mutex);
-    received.push_back(m);
-  });
+  PlaneArrayRecorder recorder;
   ros::WallDuration(3.0).sleep();  // let the subscriptions (ours, the detector's, depth_image_proc's) connect
   int code = 0;
   const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 1 " + bag, &code);
   ASSERT_EQ(code, 0) << played;
   ros::WallDuration(2.0).sleep();
 
-  std::lock_guard<std::mutex> lock(mutex);
+  const std::vector<PlaneArray::ConstPtr> received = recorder.received();
   ASSERT_FALSE(received.empty()) << "no plane array: the depth images never became clouds the detector took";
   const PlaneArray& last = *received.back();
   EXPECT_EQ(last.header.frame_id, "world");
@@ -41,17 +36,8 @@ TEST(DepthImage, ATumStyleBagGivesTheRoomsPlanes)
   // Every large plane of the last frame (the floor, the walls in view), once, within 0.01 rad and 2 cm.
   ASSERT_GE(truth.size(), 2u);
   for (const TruePlane& t : truth)
-  {
-    int matches = 0;
-    for (const Plane& p : last.planes)
-    {
-      const Eigen::Vector3d n(p.normal.x, p.normal.y, p.normal.z);
-      const double sign = n.dot(t.normal) >= 0.0 ? 1.0 : -1.0;
-      matches += std::acos(std::min(1.0, std::abs(n.dot(t.normal)))) < 0.01 && std::abs(sign * p.d - t.d) < 0.02;
-    }
-    EXPECT_EQ(matches, 1) << t.name << " (n " << t.normal.transpose() << ", d " << t.d << ") among "
-                          << last.planes.size() << " planes";
-  }
+    EXPECT_EQ(matchesOf(last, t, 0.01, 0.02), 1) << t.name << " (n " << t.normal.transpose() << ", d " << t.d << ") among "
+                                                 << last.planes.size() << " planes";
 }
 
 int main(int argc, char** argv)

@@ -16,6 +16,7 @@
 
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/core/depth_image.h"
+#include "plane_array_helpers.h"
 #include "test_bags.h"
 
 using namespace hough_plane_detector;
@@ -114,17 +115,8 @@ TEST(FreenectSource, AFakenectRecordingOfARoomGivesItsPlanes)
   ASSERT_TRUE(planes) << "no plane array: the fakenect frames never reached the detector\n" << output;
   // Every large plane in view once, within 0.01 rad and 2 cm, from the raw disparity's steps.
   for (const TruePlane& t : truth)
-  {
-    int matches = 0;
-    for (const Plane& p : planes->planes)
-    {
-      const Eigen::Vector3d n(p.normal.x, p.normal.y, p.normal.z);
-      const double sign = n.dot(t.normal) >= 0.0 ? 1.0 : -1.0;
-      matches += std::acos(std::min(1.0, std::abs(n.dot(t.normal)))) < 0.01 && std::abs(sign * p.d - t.d) < 0.02;
-    }
-    EXPECT_EQ(matches, 1) << t.name << " (n " << t.normal.transpose() << ", d " << t.d << ") among "
-                          << planes->planes.size() << " planes";
-  }
+    EXPECT_EQ(matchesOf(*planes, t, 0.01, 0.02), 1) << t.name << " (n " << t.normal.transpose() << ", d " << t.d
+                                                    << ") among " << planes->planes.size() << " planes";
 }
 
 TEST(FreenectSource, AMissingRecordingIsAClearErrorNotACrash)

@@ -679,12 +679,7 @@ TEST(PlaneDetector, HoughSpaceOfABigRoomStaysUnderOnePercentOfTheDenseArray)
 {
   // 10 x 10 x 3 m with four walls, floor, ceiling and 16 boxes: 80+ planes.
   Scene scene;
-  scene.addRectangle({0, 0, 0}, kX, kY, 5.0, 5.0, "floor");
-  scene.addRectangle({0, 0, 3.0}, kX, kY, 5.0, 5.0, "ceiling");
-  scene.addRectangle({5.0, 0, 1.5}, kY, kZ, 5.0, 1.5, "e");
-  scene.addRectangle({-5.0, 0, 1.5}, kY, kZ, 5.0, 1.5, "w");
-  scene.addRectangle({0, 5.0, 1.5}, kX, kZ, 5.0, 1.5, "n");
-  scene.addRectangle({0, -5.0, 1.5}, kX, kZ, 5.0, 1.5, "s");
+  scene.addRoom(5.0, 5.0, 3.0);
   for (int i = 0; i < 16; ++i)
   {
     const double a = i * 2 * M_PI / 16;

@@ -21,6 +21,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "hough_plane_detector/ros/depth_camera_publisher.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
 
 namespace hough_plane_detector
@@ -139,17 +140,10 @@ inline sensor_msgs::Image toDepthImage(const RenderedFrame& frame, const std::st
 
 inline sensor_msgs::CameraInfo toCameraInfo(const CameraIntrinsics& k, const std::string& frame_id, double stamp)
 {
-  sensor_msgs::CameraInfo info;
-  info.header.frame_id = frame_id;
-  info.header.stamp.fromSec(stamp);
-  info.width = k.width;
-  info.height = k.height;
-  info.distortion_model = "plumb_bob";
-  info.D.assign(5, 0.0);
-  info.K = {k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1};
-  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  info.P = {k.fx, 0, k.cx, 0, 0, k.fy, k.cy, 0, 0, 0, 1, 0};
-  return info;
+  std_msgs::Header header;
+  header.frame_id = frame_id;
+  header.stamp.fromSec(stamp);
+  return cameraInfoOf(k, header);
 }
 
 // /world -> /kinect (the motion capture's camera body, x forward) -> /openni_depth_optical_frame,

@@ -56,15 +56,9 @@ void DepthCameraPublisher::publish(const uint16_t* millimetres, int width, int h
   }
   if (info_pub_.getNumSubscribers() > 0)
   {
-    sensor_msgs::CameraInfo::Ptr info(new sensor_msgs::CameraInfo);
-    info->header = header;
-    info->width = width;
+    sensor_msgs::CameraInfo::Ptr info(new sensor_msgs::CameraInfo(cameraInfoOf(k, header)));
+    info->width = width;  // the frame's, should a device send another size than it announced
     info->height = height;
-    info->distortion_model = "plumb_bob";
-    info->D.assign(5, 0.0);
-    info->K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
-    info->R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-    info->P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
     info_pub_.publish(info);
   }
   if (cloud_pub_.getNumSubscribers() == 0) return;

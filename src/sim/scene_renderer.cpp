@@ -31,6 +31,17 @@ void Scene::addBox(const Eigen::Vector3d& center, const Eigen::Vector3d& half, d
   addRectangle(center - half.y() * ey, ex, ez, half.x(), half.z(), name + "_right");
 }
 
+void Scene::addRoom(double half_x, double half_y, double height)
+{
+  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
+  addRectangle({0, 0, 0}, ex, ey, half_x, half_y, "floor");
+  addRectangle({0, 0, height}, ex, ey, half_x, half_y, "ceiling");
+  addRectangle({half_x, 0, height / 2}, ey, ez, half_y, height / 2, "wall_east");
+  addRectangle({-half_x, 0, height / 2}, ey, ez, half_y, height / 2, "wall_west");
+  addRectangle({0, half_y, height / 2}, ex, ez, half_x, height / 2, "wall_north");
+  addRectangle({0, -half_y, height / 2}, ex, ez, half_x, height / 2, "wall_south");
+}
+
 std::vector<TruePlane> Scene::truePlanes(std::vector<int>* rectangle_plane) const
 {
   std::vector<TruePlane> planes;
@@ -199,13 +210,7 @@ Eigen::Isometry3d lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& targ
 Scene makeOfficeRoom()
 {
   Scene s;
-  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
-  s.addRectangle({0, 0, 0}, ex, ey, 3.0, 2.5, "floor");
-  s.addRectangle({0, 0, 2.8}, ex, ey, 3.0, 2.5, "ceiling");
-  s.addRectangle({3.0, 0, 1.4}, ey, ez, 2.5, 1.4, "wall_east");
-  s.addRectangle({-3.0, 0, 1.4}, ey, ez, 2.5, 1.4, "wall_west");
-  s.addRectangle({0, 2.5, 1.4}, ex, ez, 3.0, 1.4, "wall_north");
-  s.addRectangle({0, -2.5, 1.4}, ex, ez, 3.0, 1.4, "wall_south");
+  s.addRoom(3.0, 2.5, 2.8);
   s.addBox({1.6, 1.2, 0.375}, {0.6, 0.4, 0.375}, 0.3, "table");
   s.addBox({-2.6, -1.5, 0.6}, {0.3, 0.5, 0.6}, 0.0, "cabinet");
   s.addBox({0.5, -2.3, 0.45}, {0.8, 0.2, 0.45}, 0.0, "shelf");
@@ -246,13 +251,7 @@ Scene makeRampStairsHall()
 Scene makeClutteredLab()
 {
   Scene s;
-  const Eigen::Vector3d ex = Eigen::Vector3d::UnitX(), ey = Eigen::Vector3d::UnitY(), ez = Eigen::Vector3d::UnitZ();
-  s.addRectangle({0, 0, 0}, ex, ey, 2.5, 2.0, "floor");
-  s.addRectangle({0, 0, 2.6}, ex, ey, 2.5, 2.0, "ceiling");
-  s.addRectangle({2.5, 0, 1.3}, ey, ez, 2.0, 1.3, "wall_east");
-  s.addRectangle({-2.5, 0, 1.3}, ey, ez, 2.0, 1.3, "wall_west");
-  s.addRectangle({0, 2.0, 1.3}, ex, ez, 2.5, 1.3, "wall_north");
-  s.addRectangle({0, -2.0, 1.3}, ex, ez, 2.5, 1.3, "wall_south");
+  s.addRoom(2.5, 2.0, 2.6);
   s.addBox({1.5, 1.3, 0.37}, {0.7, 0.35, 0.37}, 0.0, "desk_north");
   s.addBox({-1.2, -1.4, 0.37}, {0.5, 0.4, 0.37}, 0.5, "desk_south");
   s.addBox({-2.2, 1.2, 0.9}, {0.25, 0.45, 0.9}, 0.0, "cabinet_tall");

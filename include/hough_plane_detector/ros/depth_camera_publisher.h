@@ -7,11 +7,27 @@
 #include <vector>
 
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
 
 #include "hough_plane_detector/core/camera_intrinsics.h"
 
 namespace hough_plane_detector
 {
+
+// The camera_info of an undistorted pinhole depth camera.
+inline sensor_msgs::CameraInfo cameraInfoOf(const CameraIntrinsics& k, const std_msgs::Header& header)
+{
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.width = k.width;
+  info.height = k.height;
+  info.distortion_model = "plumb_bob";
+  info.D.assign(5, 0.0);
+  info.K = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
+  info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  info.P = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
+  return info;
+}
 
 // A device's frame clock mapped onto ROS time: anchored at the first frame and again whenever
 // the two clocks drift 0.1 s apart (a wrapped counter, a wrong clock rate, a paused recording).

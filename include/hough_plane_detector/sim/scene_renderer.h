@@ -56,6 +56,9 @@ struct Scene
                     double half_u, double half_v, const std::string& name);
   // A box standing on z = center.z - half.z, turned by yaw; its bottom face is left out.
   void addBox(const Eigen::Vector3d& center, const Eigen::Vector3d& half, double yaw, const std::string& name);
+  // Floor (z = 0), ceiling and four walls of a room 2 half_x by 2 half_y about the origin, x
+  // east, y north: "floor", "ceiling", "wall_east", "wall_west", "wall_north", "wall_south".
+  void addRoom(double half_x, double half_y, double height);
   // Distinct infinite planes of the rectangles (coplanar rectangles are one plane), and for
   // each rectangle the index of its plane.
   std::vector<TruePlane> truePlanes(std::vector<int>* rectangle_plane = nullptr) const;
