@@ -27,15 +27,17 @@ struct Frame
 {
   DetectorParams params;
   HoughParameterization param{params.effectiveAngleStep(), params.effectiveDStep(), params.max_distance, 8};
-  SceneRenderer renderer{stepScene()};
+  SceneRenderer renderer;
   RenderedFrame rendered;
   FrameData frame;
   PlanarityTests tests{params, frame};
 
-  Frame()
+  explicit Frame(const Scene& scene = stepScene(),
+                 const Eigen::Isometry3d& pose = lookAt(Eigen::Vector3d(0, 0, 1.2), Eigen::Vector3d(3, 0, 0.4)))
+    : renderer(scene)
   {
     KinectNoise noise;
-    rendered = renderer.render(lookAt(Eigen::Vector3d(0, 0, 1.2), Eigen::Vector3d(3, 0, 0.4)), noise, 7);
+    rendered = renderer.render(pose, noise, 7);
     frame.measure(rendered.view(), rendered.camera_to_world, params, DepthNoiseModel(params.sensor_model, 1.0, 0.0));
     frame.block_claim.assign(frame.blocks.size(), 0);
   }
@@ -96,6 +98,26 @@ TEST(PlanarityTests, AWallPassesAndAPillarFails)
   EXPECT_TRUE(f.tests.isPlanarFit(f.tests.weightedMoments(wall), wall));
   EXPECT_TRUE(f.tests.halvesAgree(wall, 0, wall.size(), f.params.merge_angle));
   EXPECT_FALSE(f.tests.isPlanarFit(f.tests.weightedMoments(pillar), pillar));
+}
+
+TEST(PlanarityTests, AFaceBowedLikeCardboardPassesACanFails)
+{
+  // Real box faces bow by about 1/m (osd-learn); a can's side turns 30 times as fast. Both
+  // patches are 15 cm wide, 1 m ahead: their halves tilt apart by more than merge_angle and
+  // far beyond the noise, but only the can bends faster than a plane may (kMaxPlaneCurvature).
+  for (const double radius : {1.0, 0.25})
+  {
+    Scene scene;
+    scene.cylinders.push_back({Eigen::Vector3d(1.0 + radius, 0, 0), radius, 2.0});
+    Frame f(scene, lookAt(Eigen::Vector3d(0, 0, 1.0), Eigen::Vector3d(1, 0, 1.0)));
+    std::vector<int> patch;
+    for (int b : f.blocksOn(-1))
+      if (std::abs(f.frame.blocks[b].centroid.x()) < 0.075 && std::abs(f.frame.blocks[b].centroid.y()) < 0.2)
+        patch.push_back(b);
+    ASSERT_GT(patch.size(), 60u) << "radius " << radius;
+    EXPECT_EQ(f.tests.halvesAgree(patch, 0, patch.size(), f.params.merge_angle), radius > 1.0 / kMaxPlaneCurvature)
+        << "radius " << radius;
+  }
 }
 
 TEST(PlanarityTests, TheLikelihoodRatioTellsTheTrueNormalFromOneDegreeOff)

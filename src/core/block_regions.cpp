@@ -14,9 +14,6 @@ constexpr double kMinBlockSigma = 0.001;   // m: no block is judged flatter than
 constexpr double kMaxNormalTolerance = 1.0;  // rad: a block's normal is never trusted less than this
 constexpr double kMaxThicknessRatio = 0.25;  // noise variance over in-plane spread: beyond, no normal
 constexpr double kMinRaySine = 0.1;  // rays at least ~6 deg to a plane
-// A surface bending more than this (1/m: radius 0.5 m) is not a plane; cardboard faces and
-// warped walls bend far less, pillars, balls and cans more.
-constexpr double kMaxPlaneCurvature = 2.0;
 // Depth error that does not average out over a block (calibration residue of structured
 // light, surfaces a little off flat), per squared metre of depth: 1.5 mm at 1 m.
 constexpr double kSystematicPerSquareMetre = 0.0015;

@@ -79,8 +79,14 @@ bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, s
       tilt_variance += spread > 0.0 ? half_variance[h] / (half_blocks[h] * spread) : 1e9;
     }
     const double tilt = unsignedAngle(half_normals[0], half_normals[1]);
-    // Windows' fit: the paper's fixed tolerance; regions: also beyond what the fits' noise explains.
-    if (tilt > max_angle && (!params_.region_growing || tilt > 3.0 * std::sqrt(tilt_variance))) return false;
+    if (tilt <= max_angle) continue;
+    // Windows' fit: the paper's fixed tolerance. Regions: beyond what the fits' noise explains
+    // and bending faster than a plane may (a real box face bows by 1/m) or folding by more
+    // than two Hough merges apart (a floor running into a ramp, at any size).
+    if (!params_.region_growing) return false;
+    const double separation = (halves[1].mean() - halves[0].mean()).norm();
+    const bool bends = tilt > 2.0 * max_angle || tilt > kMaxPlaneCurvature * separation;
+    if (tilt > 3.0 * std::sqrt(tilt_variance) && bends) return false;
   }
   return true;
 }

@@ -15,6 +15,10 @@
 namespace hough_plane_detector
 {
 
+// A surface bending more than this (1/m: radius 0.5 m) is not a plane; cardboard faces and
+// warped walls bend far less, pillars, balls and cans more.
+constexpr double kMaxPlaneCurvature = 2.0;
+
 // One block of the last frame, camera frame, with the noise limits the tests use.
 struct BlockInfo
 {
