@@ -139,13 +139,23 @@ TEST(PlaneDetector, AVeryNoisySensorStillGivesFloorAndWalls)
               score.detected, score.visible, score.false_detections);
 }
 
-// A wall filling the view is reported from its first frame (strong_support); counting every
-// per-frame plane once, as the paper does, needs two frames; a small patch needs two either way.
+// A wall filling the view is reported from its first frame (strong_support), and so is a
+// small tile 1 m away, whose few thousand points near the sensor measure it precisely; counting
+// every per-frame plane once, as the paper does, needs two frames. A panel with twice its
+// points 2.2 m away needs two either way.
 TEST(PlaneDetector, AStronglySupportedPlaneIsReportedAtFirstSight)
 {
   Scene scene;
   scene.addRectangle({3.0, 0, 1.0}, kY, kZ, 5.0, 5.0, "wall");
-  scene.addRectangle({1.5, 0.0, 1.0}, kY, kZ, 0.05, 0.05, "tile");  // about 3000 points from 1 m
+  // Both turned 45 deg off the wall, so that neither takes its normal (a quarter of the bar).
+  const Eigen::Vector3d tile_axis = Eigen::Vector3d(1, 1, 0).normalized(), tile_normal = tile_axis.cross(kZ);
+  const Eigen::Vector3d tile_centre(1.5, -0.25, 1.0);
+  scene.addRectangle(tile_centre, tile_axis, kZ, 0.05, 0.05, "tile");  // 10 cm square: about 2,500 points from 1 m
+  const double tile_d = -tile_normal.dot(tile_centre);
+  const Eigen::Vector3d panel_axis = Eigen::Vector3d(-1, 1, 0).normalized(), panel_normal = panel_axis.cross(kZ);
+  const Eigen::Vector3d panel_centre(2.6, 0.6, 1.0);
+  scene.addRectangle(panel_centre, panel_axis, kZ, 0.15, 0.15, "panel");  // 30 cm square: about 5,000 points from 2.2 m
+  const double panel_d = -panel_normal.dot(panel_centre);
   const SceneRenderer renderer(scene);
   const RenderedFrame first = renderer.render(lookAt({0.5, 0.0, 1.0}, {3.0, 0.3, 1.0}), kinect(1.0), 1);
   const RenderedFrame second = renderer.render(lookAt({0.5, 0.1, 1.0}, {3.0, 0.3, 1.0}), kinect(1.0), 2);
@@ -155,11 +165,16 @@ TEST(PlaneDetector, AStronglySupportedPlaneIsReportedAtFirstSight)
     params.strong_support = strong_support;
     PlaneDetector detector(params);
     feed(detector, first, 0.0);
-    EXPECT_EQ(matching(detector.planes(), kX, -3.0, 0.01, 0.02).size(), strong_support > 0 ? 1u : 0u)
+    const size_t expected = strong_support > 0 ? 1u : 0u;
+    EXPECT_EQ(matching(detector.planes(), kX, -3.0, 0.01, 0.02).size(), expected)
         << "strong_support " << strong_support << describe(detector.planes());
-    EXPECT_TRUE(matching(detector.planes(), kX, -1.5, 0.02, 0.02).empty()) << "the small tile needs a second frame";
+    EXPECT_EQ(matching(detector.planes(), tile_normal, tile_d, 0.02, 0.02).size(), expected)
+        << "strong_support " << strong_support << describe(detector.planes());
+    EXPECT_TRUE(matching(detector.planes(), panel_normal, panel_d, 0.02, 0.02).empty())
+        << "the far panel needs a second frame" << describe(detector.planes());
     feed(detector, second, 0.1);
     EXPECT_EQ(matching(detector.planes(), kX, -3.0, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+    EXPECT_EQ(matching(detector.planes(), panel_normal, panel_d, 0.02, 0.02).size(), 1u) << describe(detector.planes());
   }
 }
 

@@ -18,13 +18,15 @@ struct Map
   HoughPeakSearch search{param, params.peak_window / 2};
   PlaneMap map{params, param, voting, search};
 
-  FramePlane plane(const Eigen::Vector3d& normal, double d, double support) const
+  // first_sight_points < 0: as many as its points (all at kStrongSupportDepth or beyond).
+  FramePlane plane(const Eigen::Vector3d& normal, double d, double support, double first_sight_points = -1.0) const
   {
     FramePlane p;
     p.normal = normal.normalized();
     p.d = d;
     p.hough = param.toHough(p.normal, d);
     p.support = support;
+    p.first_sight_points = first_sight_points < 0.0 ? support : first_sight_points;
     return p;
   }
   void frame(const std::vector<FramePlane>& planes, double stamp)
@@ -52,6 +54,18 @@ TEST(PlaneMap, AWeakPlaneNeedsASecondFrameAStrongOneDoesNot)
   EXPECT_LT(std::acos(std::abs(wall.normal.x())), 0.002);
   EXPECT_NEAR(std::abs(wall.d), 2.0, 0.005);
   EXPECT_GT(wall.normal.dot(Eigen::Vector3d::Zero()) + wall.d, 0.0);  // faces the sensor at the origin
+}
+
+TEST(PlaneMap, NearPointsCountByTheirPrecisionButASmallPatchWaits)
+{
+  // 3,000 points at 1 m measure a plane like 48,000 at 2 m (Kinect noise grows with depth^2).
+  Map near;
+  near.frame({near.plane(kFloor, 1.0, 3000, 48000)}, 0.0);
+  EXPECT_EQ(near.map.planes().size(), 1u);
+  // Under 2 min_support points no frame alone reports it, however near.
+  Map small;
+  small.frame({small.plane(kFloor, 1.0, 2 * small.params.min_support - 1, 1e6)}, 0.0);
+  EXPECT_TRUE(small.map.planes().empty());
 }
 
 TEST(PlaneMap, IdsFollowAPlaneThatMovesALittleAndNewPlanesGetNewOnes)

@@ -99,6 +99,7 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
       verdict = CandidateVerdict::kNormalUndetermined;
     candidates.push_back({normal, d, peak.value, moments.count, verdict});
     if (verdict != CandidateVerdict::kAccepted) continue;
+    const double first_sight_points = tests_.firstSightPoints(blocks);  // of the tight fit, as `moments`
     // Claim everything within support_distance, not just the tight fit, so that leftovers
     // around an accepted plane cannot pose as a slightly tilted second one.
     for (int s : windows) claimed[s] = 1;
@@ -112,6 +113,7 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
     refined.value = peak.value;
     refined.support = moments.count;
     refined.parallel = snapped;
+    refined.first_sight_points = first_sight_points;
     planes.push_back(refined);
   }
 }
@@ -200,6 +202,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     refined.value = peak_value;
     refined.support = moments.count;
     refined.parallel = snapped;
+    refined.first_sight_points = tests_.firstSightPoints(region.blocks);
     refined.blocks = region.blocks;
     planes.push_back(refined);
   };

@@ -206,6 +206,7 @@ private:
       plane.hough = param_.toHough(normal_, candidate.d);
       plane.support = moments.count;
       plane.parallel = true;
+      plane.first_sight_points = tests_.firstSightPoints(blocks_);
       planes_.push_back(plane);
       addKnown(normal_, candidate.d, false);
     }

@@ -129,6 +129,19 @@ double PlanarityTests::normalUncertainty(const std::vector<int>& blocks) const
   return kept > 0.0 ? std::min(M_PI / 2, 1.0 / std::sqrt(kept)) : M_PI / 2;
 }
 
+double PlanarityTests::firstSightPoints(const std::vector<int>& blocks) const
+{
+  const double reference_sigma = frame_.noise.sigma(kStrongSupportDepth);
+  double points = 0.0;
+  for (int b : blocks)
+  {
+    const double sigma = frame_.noise.sigma(frame_.blocks[b].centroid.z());
+    const double weight = sigma > 0.0 ? reference_sigma * reference_sigma / (sigma * sigma) : 1.0;
+    points += frame_.points(b) * std::max(1.0, weight);
+  }
+  return points;
+}
+
 PointMoments PlanarityTests::weightedMoments(const std::vector<int>& blocks) const
 {
   return weightedCentroidMoments(frame_.blocks, blocks);

@@ -85,8 +85,9 @@ float PlaneMap::voteWeight(const FramePlane& plane) const
   // A plane not yet in the map adds up to 2 when strongly supported, so that a big plane is
   // reported the first time it is seen, while known planes gain 1 per frame as in the paper
   // (thinning and permanence keep their pace). Noisier sensors need more points for the same
-  // precision: the bar rises with sensor_noise^2. A plane of the parallel search, or one
-  // snapped to a known normal, measured only its offset, so a quarter of the points is as strong.
+  // precision: the bar rises with sensor_noise^2, and near points count more (detector_params.h).
+  // A plane of the parallel search, or one snapped to a known normal, measured only its
+  // offset, so a quarter of the points is as strong.
   for (const DetectedPlane& known : planes_)
   {
     const double sign = known.normal.dot(plane.normal) >= 0.0 ? 1.0 : -1.0;
@@ -94,9 +95,10 @@ float PlaneMap::voteWeight(const FramePlane& plane) const
         std::abs(known.d - sign * plane.d) < params_.merge_distance)
       return 1.0f;
   }
-  if (params_.strong_support <= 0) return 1.0f;
+  if (params_.strong_support <= 0 || plane.support < 2.0 * params_.min_support) return 1.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
-  return static_cast<float>(1.0 + std::min(1.0, plane.support / (plane.parallel ? 0.25 * strong_support : strong_support)));
+  const double points = plane.first_sight_points;
+  return static_cast<float>(1.0 + std::min(1.0, points / (plane.parallel ? 0.25 * strong_support : strong_support)));
 }
 
 void PlaneMap::matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp)

@@ -40,6 +40,7 @@ namespace hough_plane_detector
 {
 
 constexpr int kForgetByThinning = 0;
+constexpr double kStrongSupportDepth = 2.0;  // m: nearer points count more toward strong_support
 constexpr int kForgetByEvidence = 1;
 
 struct DetectorParams
@@ -68,7 +69,10 @@ struct DetectorParams
   double global_threshold = 1.5;
   // A per-frame plane not yet in the map adds 1 + min(1, points / (strong_support *
   // max(1, sensor_noise)^2)) to the global space, so one this well supported is reported at
-  // first sight; planes in the map, and all with 0, add 1 (the paper).
+  // first sight; planes in the map, and all with 0, add 1 (the paper). A point nearer than
+  // kStrongSupportDepth counts (sigma there / sigma at its depth)^2: near the sensor one
+  // frame's tests see the folds and bends noise hides farther away. A plane of under
+  // 2 min_support points always needs a second frame (too small for the curvature tests).
   int strong_support = 16000;
   // Amount every global cell loses per frame (paper 3.7: 0.01 - 0.1).
   double thinning_rate = 0.05;
@@ -112,7 +116,7 @@ struct DetectorParams
   // Per-frame planes: 1 = each Hough peak seeds regions of 8 x 8 pixel blocks grown while they
   // lie on the refitted plane within the sensor's noise, then the flat blocks left seed regions
   // of their own (small faces that raise no peak); 0 = each peak takes the windows that agree
-  // with it (the paper). First sight still follows strong_support (2000 suits table tops).
+  // with it (the paper).
   int region_growing = 1;
   // How the map forgets: 0 = thinning (paper 3.7: every cell loses thinning_rate per frame),
   // 1 = by evidence (a plane out of view keeps its state; one whose extent the frames show

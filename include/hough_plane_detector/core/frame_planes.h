@@ -50,6 +50,7 @@ struct FramePlane
   double value = 0.0;     // its local peak's value; 0 for the parallel search and leftover regions
   double support = 0.0;   // points of the frame on it
   bool parallel = false;  // with a known plane's normal: the parallel search's, or snapped to it
+  double first_sight_points = 0.0;  // support with near points weighted by precision (strong_support)
   std::vector<int> blocks;  // region_growing: the blocks of its region
 };
 

@@ -50,6 +50,9 @@ public:
   // sure of: 1 / sqrt(sum of w x^2) over the weighted centroids' spread across that axis. A
   // strip of blocks along one image row fixes no tilt about its own length.
   double normalUncertainty(const std::vector<int>& blocks) const;
+  // The blocks' points, each nearer than kStrongSupportDepth counted (sigma there / sigma at
+  // its depth)^2 times: as many points there would measure the plane as precisely.
+  double firstSightPoints(const std::vector<int>& blocks) const;
   // Moments of the blocks' centroids, each weighted by the inverse variance of the sensor at its depth.
   PointMoments weightedMoments(const std::vector<int>& blocks) const;
 
