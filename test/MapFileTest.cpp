@@ -153,7 +153,9 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
   }
 
   // Version 1: the same bytes without the belief section, version 1, checksum (64-bit FNV-1a) anew.
-  PlaneDetector thinning{DetectorParams()};
+  DetectorParams thinning_params;
+  thinning_params.forgetting = kForgetByThinning;  // a map without beliefs, as version 1 wrote
+  PlaneDetector thinning{thinning_params};
   warmUp(thinning, 4);
   std::string bytes = thinning.serializeMap();
   bytes.resize(bytes.size() - sizeof(uint64_t) - sizeof(uint32_t));  // checksum, then a belief count of 0

@@ -263,6 +263,7 @@ std::vector<DetectedPlane> runTwoWalls(const DetectorParams& params, int seen, i
 TEST(PlaneDetector, ThinningRemovesAVanishedPlaneAndFreesItsChunks)
 {
   DetectorParams params;
+  params.forgetting = kForgetByThinning;
   params.thinning_rate = 0.2;
   size_t before = 0, after = 0;
   const auto planes = runTwoWalls(params, 8, 45, &before, &after);
@@ -276,6 +277,7 @@ TEST(PlaneDetector, ThinningRemovesAVanishedPlaneAndFreesItsChunks)
 TEST(PlaneDetector, APermanentPlaneStays)
 {
   DetectorParams params;
+  params.forgetting = kForgetByThinning;
   params.thinning_rate = 0.2;
   params.permanence_cap = 4.0;
   const auto planes = runTwoWalls(params, 8, 45, nullptr, nullptr);

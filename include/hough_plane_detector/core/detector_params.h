@@ -120,10 +120,10 @@ struct DetectorParams
   // of their own (small faces that raise no peak); 0 = each peak takes the windows that agree
   // with it (the paper).
   int region_growing = 1;
-  // How the map forgets: 0 = thinning (paper 3.7: every cell loses thinning_rate per frame),
-  // 1 = by evidence (a plane out of view keeps its state; one whose extent the frames show
-  // to be gone leaves within about ten frames; core/plane_evidence.h).
-  int forgetting = 0;
+  // How the map forgets: 1 = by evidence (a plane out of view keeps its state; one whose
+  // extent the frames show to be gone leaves within about ten frames; core/plane_evidence.h),
+  // 0 = thinning (paper 3.7: every cell loses thinning_rate per frame; Fig. 6-8 use it).
+  int forgetting = 1;
 
   // Returns an empty string when the combination is valid, otherwise what is wrong.
   std::string validate() const;
