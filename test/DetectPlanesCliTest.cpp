@@ -73,9 +73,14 @@ TEST(DetectPlanesCli, ReadsABagWithTfIntoWorldFramePlanes)
   const auto frames = parseFrames(json, &ids);
   ASSERT_EQ(frames.size(), 8u) << json;
   EXPECT_EQ(ids[0], "odom");
-  // The floor and the east wall of the office, in the odom frame.
+  // The floor and the east wall of the office, in the odom frame, each with its shape.
   EXPECT_TRUE(hasPlane(frames.back(), Eigen::Vector3d::UnitZ(), 0.0)) << json;
   EXPECT_TRUE(hasPlane(frames.back(), Eigen::Vector3d::UnitX(), -3.0)) << json;
+  for (const JsonPlane& plane : frames.back())
+  {
+    EXPECT_GT(plane.area, 0.01) << "a plane without outlines: n " << plane.normal.transpose() << " d " << plane.d;
+    EXPECT_GE(plane.boundary_corners, 3u);
+  }
 }
 
 TEST(DetectPlanesCli, SkipsAFrameWithoutTransformAndSaysSo)

@@ -217,6 +217,8 @@ struct JsonPlane
 {
   Eigen::Vector3d normal;
   double d;
+  double area = 0.0;  // of its outlines (m^2), 0 when it has none
+  size_t boundary_corners = 0;
 };
 
 // The frames of detect_planes' JSON lines (other lines, such as warnings, are skipped).
@@ -232,9 +234,18 @@ inline std::vector<std::vector<JsonPlane>> parseFrames(const std::string& output
     if (frame_ids) frame_ids->push_back(frame.at("frame_id").get<std::string>());
     std::vector<JsonPlane> planes;
     for (const auto& p : frame.at("planes"))
-      planes.push_back({Eigen::Vector3d(p.at("normal")[0].get<double>(), p.at("normal")[1].get<double>(),
-                                        p.at("normal")[2].get<double>()),
-                        p.at("d").get<double>()});
+    {
+      JsonPlane plane{Eigen::Vector3d(p.at("normal")[0].get<double>(), p.at("normal")[1].get<double>(),
+                                      p.at("normal")[2].get<double>()),
+                      p.at("d").get<double>()};
+      if (p.contains("outlines"))
+        for (const auto& region : p.at("outlines"))
+        {
+          plane.area += region.at("area").get<double>();
+          plane.boundary_corners += region.at("boundary").size();
+        }
+      planes.push_back(plane);
+    }
     frames.push_back(planes);
   }
   return frames;

@@ -105,8 +105,18 @@ std::vector<std::string> detectorParamHelp()
   return lines;
 }
 
+namespace
+{
+nlohmann::ordered_json pointsToJson(const std::vector<Eigen::Vector3d>& points)
+{
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const Eigen::Vector3d& p : points) out.push_back({p.x(), p.y(), p.z()});
+  return out;
+}
+}  // namespace
+
 std::string frameToJson(int frame, double stamp, const std::string& frame_id, double ms,
-                        const std::vector<DetectedPlane>& planes)
+                        const std::vector<DetectedPlane>& planes, const std::vector<std::vector<PlaneOutline>>& outlines)
 {
   // nlohmann::json prints doubles so that they read back exactly (a 2025 stamp keeps its
   // microseconds) and escapes strings; a non-finite number becomes null.
@@ -126,6 +136,21 @@ std::string frameToJson(int frame, double stamp, const std::string& frame_id, do
     plane["support"] = p.support;
     plane["confirmations"] = p.confirmations;
     plane["contradictions"] = p.contradictions;
+    const size_t index = out["planes"].size();
+    if (index < outlines.size())
+    {
+      // One object per connected region: its area (m^2, holes excluded), outline and holes.
+      plane["outlines"] = nlohmann::ordered_json::array();
+      for (const PlaneOutline& region : outlines[index])
+      {
+        nlohmann::ordered_json shape;
+        shape["area"] = region.area;
+        shape["boundary"] = pointsToJson(region.boundary);
+        shape["holes"] = nlohmann::ordered_json::array();
+        for (const auto& hole : region.holes) shape["holes"].push_back(pointsToJson(hole));
+        plane["outlines"].push_back(shape);
+      }
+    }
     out["planes"].push_back(plane);
   }
   return out.dump();

@@ -114,7 +114,10 @@ int main(int argc, char** argv)
       ++frame_index;
       return false;
     }
-    out << frameToJson(frame_index++, stamp, frame_id, detector.lastTimings().total_ms, detector.planes()) << "\n";
+    std::vector<std::vector<PlaneOutline>> outlines;
+    for (const DetectedPlane& plane : detector.planes()) outlines.push_back(detector.outlines(plane));
+    out << frameToJson(frame_index++, stamp, frame_id, detector.lastTimings().total_ms, detector.planes(), outlines)
+        << "\n";
     ++processed;
     return true;
   };

@@ -15,8 +15,10 @@ bool setDetectorParam(DetectorParams& params, const std::string& name, const std
 // "name (type, default)" lines for --help.
 std::vector<std::string> detectorParamHelp();
 
-// {"frame": 0, "stamp": 12.34, "frame_id": "odom", "ms": 4.2, "planes": [...]}
+// {"frame": 0, "stamp": 12.34, "frame_id": "odom", "ms": 4.2, "planes": [...]}; `outlines`,
+// when given, holds each plane's region shapes (PlaneDetector::outlines), in the planes' order.
 std::string frameToJson(int frame, double stamp, const std::string& frame_id, double ms,
-                        const std::vector<DetectedPlane>& planes);
+                        const std::vector<DetectedPlane>& planes,
+                        const std::vector<std::vector<PlaneOutline>>& outlines = {});
 
 }  // namespace hough_plane_detector
