@@ -227,32 +227,3 @@ TEST(ParallelPlanes, FindsTheStepFromTheFloorsNormalAndMeasuresTheMapsFloorAgain
   findParallelPlanes(f.params, f.param, f.frame, f.tests, {floor}, planes, candidates);
   EXPECT_TRUE(planes.empty());
 }
-
-TEST(BlockRegions, ANarrowFaceWhoseRimLeansIsNotCurvedACanIs)
-{
-  // Two columns of 16 blocks 1.1 cm apart, 0.8 m ahead, facing the sensor; each block's normal
-  // turned about the vertical by +-tilt / 2 (one column each way) and scattered by +-8 deg.
-  // A box top seen over its front leans 0.1 rad across its narrow side (its rim blocks lean on
-  // the fold); a can's side (r = 3.3 cm) turns 0.33 rad between the same columns.
-  DetectorParams params;
-  NormalEstimator grid;
-  auto strip = [&](double tilt) {
-    std::vector<BlockInfo> info(32);
-    for (int b = 0; b < 32; ++b)
-    {
-      const int column = b % 2, row = b / 2;
-      const double scatter = (row % 2 ? 1.0 : -1.0) * 0.08;
-      const double angle = (column ? 0.5 : -0.5) * tilt + scatter;
-      info[b].valid = info[b].planar = true;
-      info[b].centroid = Eigen::Vector3d(0.011 * column, 0.011 * row, 0.8);
-      info[b].normal = Eigen::Vector3d(std::sin(angle), 0.0, -std::cos(angle));
-      info[b].normal_tolerance = 0.3;
-    }
-    return info;
-  };
-  std::vector<int> blocks(32);
-  for (int b = 0; b < 32; ++b) blocks[b] = b;
-  const std::vector<BlockInfo> leaning = strip(0.1), can = strip(0.33);
-  EXPECT_FALSE(BlockRegionGrower(grid, leaning, params).normalsTurn(blocks, -Eigen::Vector3d::UnitZ()));
-  EXPECT_TRUE(BlockRegionGrower(grid, can, params).normalsTurn(blocks, -Eigen::Vector3d::UnitZ()));
-}

@@ -202,10 +202,7 @@ bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen:
     }
     const double tilt = std::acos(std::min(1.0, half_normal[0].dot(half_normal[1])));
     const double separation = (where[1] - where[0]).norm();
-    // Turning faster than a plane may bend, by three standard errors: a narrow face (a box top
-    // seen over its front) whose rim blocks lean on the fold turns a lot over a short
-    // separation, but not significantly beyond the plane's limit; a can's side does.
-    if (tilt - kMaxPlaneCurvature * separation > 3.0 * std::sqrt(error_variance)) return true;
+    if (tilt > 3.0 * std::sqrt(error_variance) && tilt > kMaxPlaneCurvature * separation) return true;
   }
   return false;
 }

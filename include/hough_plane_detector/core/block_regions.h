@@ -95,8 +95,8 @@ public:
   // significantly better (chi^2 drop over 3 degrees of freedom, p < 0.001) and its larger
   // principal curvature exceeds what a plane may have (a pillar's, a ball's or a can's side).
   bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
-  // True when the blocks' own normals turn across the region faster than a plane may bend
-  // (kMaxPlaneCurvature), by three standard errors of their measured scatter (a can's side).
+  // True when the blocks' own normals turn across the region, significantly beyond their
+  // measured scatter and by more than a plane's curvature may be (a pillar's or can's side).
   bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // Weighted least-squares plane of the blocks' centroids; false when they fix no plane.
   bool fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
