@@ -11,19 +11,20 @@ CMAKE_ARGS := -DCMAKE_BUILD_TYPE=Release
 TEST_ENV :=
 else ifeq ($(SANITIZE),thread)
 # make tsan builds this workspace; see the tsan target. TSAN_CONTROL=1 builds the negative
-# control (save_map without the map lock) in its own workspace.
+# control (test/negative_controls: the map is never locked) in its own workspace.
 WS := build/ws-tsan$(if $(TSAN_CONTROL),-control)
-TSAN_DEFINES := $(if $(TSAN_CONTROL),-DHOUGH_PLANE_DETECTOR_TSAN_NEGATIVE_CONTROL)
-CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=-fsanitize=thread -fno-omit-frame-pointer $(TSAN_DEFINES)" \
-  "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread" "-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread"
+CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=-fsanitize=thread -fno-omit-frame-pointer" \
+  "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread" "-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread" \
+  -DHOUGH_PLANE_DETECTOR_NEGATIVE_CONTROL=$(if $(TSAN_CONTROL),tsan)
 TEST_ENV :=
 else
 # LEAK_CONTROL=1 (make soak-control) builds the negative control of the leak check in its own
-# workspace: the nodelet loses a buffer per cloud.
+# workspace: test/negative_controls/leaked_buffer.cpp loses a buffer when the nodelet loads.
 WS := build/ws-sanitize$(if $(LEAK_CONTROL),-leak-control)
-SAN := -fsanitize=$(SANITIZE) $(if $(LEAK_CONTROL),-DHOUGH_PLANE_DETECTOR_LEAK_NEGATIVE_CONTROL)
+SAN := -fsanitize=$(SANITIZE)
 CMAKE_ARGS := -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS=$(SAN) -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
-  "-DCMAKE_EXE_LINKER_FLAGS=$(SAN)" "-DCMAKE_SHARED_LINKER_FLAGS=$(SAN)"
+  "-DCMAKE_EXE_LINKER_FLAGS=$(SAN)" "-DCMAKE_SHARED_LINKER_FLAGS=$(SAN)" \
+  -DHOUGH_PLANE_DETECTOR_NEGATIVE_CONTROL=$(if $(LEAK_CONTROL),leak)
 SAN_RUNTIMES := $(if $(findstring address,$(SANITIZE)),$(shell gcc -print-file-name=libasan.so)) \
   $(if $(findstring undefined,$(SANITIZE)),$(shell gcc -print-file-name=libubsan.so))
 TEST_ENV := ASAN_OPTIONS=detect_leaks=0:verify_asan_link_order=0 UBSAN_OPTIONS=print_stacktrace=1 \

@@ -2,7 +2,8 @@
 # The ThreadSanitizer run of make tsan / make tsan-control: test/concurrency.test for SECONDS
 # with the nodelet manager preloading libtsan; reports go to WORKSPACE/tsan.manager.*.
 # EXPECT=clean passes when the manager has no report; EXPECT=reported (the negative control,
-# built without save_map's lock) passes only when a race through saveMapService is reported.
+# built with test/negative_controls/map_lock_skipped.cpp: the map is never locked) passes
+# only when a race through saveMapService is reported.
 # Usage: scripts/run_tsan.sh WORKSPACE SECONDS clean|reported
 set -uo pipefail
 ws=$1

@@ -41,7 +41,7 @@ PlaneDetectorRos::~PlaneDetectorRos()
   subscriber_.reset();
   if (!save_on_shutdown_.empty() && detector_)
   {
-    std::lock_guard<std::mutex> lock(map_mutex_);
+    const auto lock = lockMap();
     std::string error;
     if (detector_->saveMap(save_on_shutdown_, &error))
       ROS_INFO_NAMED(name_, "Saved %zu planes to ~save_on_shutdown %s.", detector_->planes().size(), save_on_shutdown_.c_str());
@@ -163,7 +163,7 @@ void PlaneDetectorRos::checkFrameKnown(const sensor_msgs::PointCloud2ConstPtr& c
 {
   // Right after a tf reset every frame looks unknown for a moment: no verdict then.
   if (timeJumpedBack(cloud->header.stamp) || !frameUnknown(cloud->header.frame_id)) return;
-  std::lock_guard<std::mutex> lock(map_mutex_);
+  const auto lock = lockMap();
   ++frames_dropped_;
   ROS_WARN_THROTTLE_NAMED(5.0, name_, "Cloud skipped: no transform from '%s' to '%s': tf has never seen frame '%s'.",
                         cloud->header.frame_id.c_str(), world_frame_.c_str(), cloud->header.frame_id.c_str());
@@ -176,7 +176,7 @@ bool PlaneDetectorRos::timeJumpedBack(const ros::Time& stamp)
 {
   double jump = 0.0;
   {
-    std::lock_guard<std::mutex> lock(map_mutex_);
+    const auto lock = lockMap();
     if (!last_arrival_stamp_.isZero() && stamp + ros::Duration(kTimeJumpTolerance) < last_arrival_stamp_)
     {
       jump = (last_arrival_stamp_ - stamp).toSec();
@@ -199,7 +199,7 @@ void PlaneDetectorRos::failureCallback(const sensor_msgs::PointCloud2ConstPtr& c
                                      tf2_ros::filter_failure_reasons::FilterFailureReason reason)
 {
   if (frameUnknown(cloud->header.frame_id)) return;  // counted and reported at arrival
-  std::lock_guard<std::mutex> lock(map_mutex_);
+  const auto lock = lockMap();
   ++frames_dropped_;
   ROS_WARN_THROTTLE_NAMED(5.0, name_, "Cloud skipped: no transform from '%s' to '%s' at %.3f (%s).",
                         cloud->header.frame_id.c_str(), world_frame_.c_str(), cloud->header.stamp.toSec(),
@@ -210,10 +210,6 @@ void PlaneDetectorRos::failureCallback(const sensor_msgs::PointCloud2ConstPtr& c
 
 void PlaneDetectorRos::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& cloud)
 {
-#ifdef HOUGH_PLANE_DETECTOR_LEAK_NEGATIVE_CONTROL  // defined only by make soak-control, which must see a leak
-  leak_control_ = new char[4096];  // the previous buffer is lost
-  leak_control_[0] = 1;
-#endif
   Eigen::Isometry3d camera_to_world;
   try
   {
@@ -222,7 +218,7 @@ void PlaneDetectorRos::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& clo
   }
   catch (const tf2::TransformException& e)
   {
-    std::lock_guard<std::mutex> lock(map_mutex_);
+    const auto lock = lockMap();
     ++frames_dropped_;
     ROS_WARN_THROTTLE_NAMED(5.0, name_, "Cloud skipped: %s", e.what());
     return;
@@ -232,7 +228,7 @@ void PlaneDetectorRos::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& clo
   std::vector<float> converted;
   std::string error = makeCloudView(layoutOf(*cloud), view, converted);
 
-  std::lock_guard<std::mutex> lock(map_mutex_);
+  const auto lock = lockMap();
   // The subscriber queue drops the oldest clouds when the detector falls behind; drivers
   // number their messages, so gaps in header.seq count them.
   if (last_seq_ != 0 && cloud->header.seq > last_seq_ + 1) frames_queue_dropped_ += cloud->header.seq - last_seq_ - 1;
@@ -301,7 +297,7 @@ void PlaneDetectorRos::publishLabels(const sensor_msgs::PointCloud2& cloud, cons
 void PlaneDetectorRos::reconfigure(HoughPlaneDetectorConfig& config, uint32_t /*level*/)
 {
   const DetectorParams requested = toParams(config);
-  std::lock_guard<std::mutex> lock(map_mutex_);
+  const auto lock = lockMap();
   const std::string problem = requested.validate();
   if (!problem.empty())
   {
@@ -331,7 +327,7 @@ void PlaneDetectorRos::reconfigure(HoughPlaneDetectorConfig& config, uint32_t /*
 
 bool PlaneDetectorRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
 {
-  std::lock_guard<std::mutex> lock(map_mutex_);
+  const auto lock = lockMap();
   detector_->reset();
   publishMap();  // an empty array and a DELETEALL: no stale markers
   ROS_INFO_NAMED(name_, "Plane map reset.");
@@ -340,9 +336,7 @@ bool PlaneDetectorRos::resetService(std_srvs::Empty::Request&, std_srvs::Empty::
 
 bool PlaneDetectorRos::saveMapService(SaveMap::Request& req, SaveMap::Response& res)
 {
-#ifndef HOUGH_PLANE_DETECTOR_TSAN_NEGATIVE_CONTROL  // defined only by make tsan-control, which must see a race
-  std::lock_guard<std::mutex> lock(map_mutex_);
-#endif
+  const auto lock = lockMap();
   std::string error;
   res.success = detector_->saveMap(req.path, &error);
   res.message = res.success ? "saved " + std::to_string(detector_->planes().size()) + " planes to " + req.path : error;
@@ -355,7 +349,7 @@ bool PlaneDetectorRos::saveMapService(SaveMap::Request& req, SaveMap::Response& 
 
 bool PlaneDetectorRos::loadMapService(LoadMap::Request& req, LoadMap::Response& res)
 {
-  std::lock_guard<std::mutex> lock(map_mutex_);
+  const auto lock = lockMap();
   std::string error;
   res.success = detector_->loadMap(req.path, &error);
   res.message = res.success ? "loaded " + std::to_string(detector_->planes().size()) + " planes from " + req.path
@@ -370,7 +364,7 @@ bool PlaneDetectorRos::loadMapService(LoadMap::Request& req, LoadMap::Response& 
 
 void PlaneDetectorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
-  std::lock_guard<std::mutex> lock(map_mutex_);
+  const auto lock = lockMap();
   const MemoryReport memory = detector_->memory();
   double rate = 0.0;
   if (arrivals_.size() >= 2)

@@ -60,6 +60,10 @@ private:
   bool loadMapService(LoadMap::Request& req, LoadMap::Response& res);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
+  // map_mutex_, held until the returned lock goes (src/ros/map_lock.cpp; make tsan-control
+  // links a version that does not lock, to prove the race check can fail).
+  std::unique_lock<std::mutex> lockMap();
+
   std::string name_;
   std::mutex map_mutex_;  // guards detector_, params_ and the counters on every path
   std::unique_ptr<PlaneDetector> detector_;
@@ -90,9 +94,6 @@ private:
   std::unique_ptr<dynamic_reconfigure::Server<HoughPlaneDetectorConfig>> reconfigure_server_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
   ros::Timer diagnostics_timer_;
-#ifdef HOUGH_PLANE_DETECTOR_LEAK_NEGATIVE_CONTROL
-  char* leak_control_ = nullptr;
-#endif
 };
 
 }  // namespace hough_plane_detector
