@@ -127,8 +127,8 @@ soak: build
 	  --error-exitcode=3 $(BIN)/soak_detector 60 2>&1 | grep -E "definitely lost|no leaks are possible|ERROR SUMMARY" || true
 	@scripts/soak_nodelet.sh $(CURDIR)/$(WS) $(SOAK_FRAMES) $(SOAK_VALGRIND_FRAMES)
 
-# Proves the nodelet's LeakSanitizer run can fail: a build whose nodelet loses a buffer per
-# cloud must have leak records through this package's code.
+# Proves the nodelet's LeakSanitizer run can fail: a build whose nodelet library loses a buffer
+# when it loads (test/negative_controls) must have leak records through this package's code.
 soak-control:
 	@$(MAKE) --no-print-directory build SANITIZE=address LEAK_CONTROL=1
 	@LEAK_EXPECTED=1 scripts/soak_nodelet.sh $(CURDIR)/build/ws-sanitize-leak-control 0 $(SOAK_VALGRIND_FRAMES)
