@@ -10,6 +10,7 @@
 
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
+#include "hough_plane_detector/tools/cli_options.h"
 
 using namespace hough_plane_detector;
 
@@ -27,7 +28,12 @@ long residentKilobytes()
 
 int main(int argc, char** argv)
 {
-  const int frames = argc > 1 ? std::atoi(argv[1]) : 10000;
+  int frames = 10000;
+  if (argc > 1 && (!parseInteger(argv[1], &frames) || frames < 1))
+  {
+    std::fprintf(stderr, "usage: soak_detector [FRAMES > 0], got '%s'\n", argv[1]);
+    return 2;
+  }
   const int lap = 120;
   SceneRenderer renderer(makeOfficeRoom());
   const auto poses = roomTour(lap);

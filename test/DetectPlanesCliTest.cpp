@@ -213,6 +213,24 @@ TEST(DetectPlanesCli, JsonNumbersRoundTrip)
   EXPECT_EQ(frame.at("planes")[0].at("support").get<int>(), 123456);
 }
 
+// Numbers on command lines are the whole text or refused (atoi read "12abc" as 12, "x" as 0).
+TEST(DetectPlanesCli, NumbersAreTheWholeTextOrRefused)
+{
+  int i = 5;
+  double x = 0.5;
+  EXPECT_TRUE(parseInteger("12", &i));
+  EXPECT_EQ(i, 12);
+  for (const char* bad : {"12abc", "", "x", "1.5", "99999999999"}) EXPECT_FALSE(parseInteger(bad, &i)) << bad;
+  EXPECT_EQ(i, 12) << "a refused text leaves the value alone";
+  EXPECT_TRUE(parseFinite("-0.25", &x));
+  EXPECT_EQ(x, -0.25);
+  for (const char* bad : {"0.3m", "", "nan", "inf", "1e999"}) EXPECT_FALSE(parseFinite(bad, &x)) << bad;
+  EXPECT_EQ(x, -0.25);
+  const RunResult refused = run("--min_support 12abc " + tempPath("none.pcd"));
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE(refused.output.find("min_support needs an integer"), std::string::npos) << refused.output;
+}
+
 // A file whose header is not a PCD header is refused by name before PCL's reader sees it
 // (PCL 1.13 crashed on one line of text).
 TEST(DetectPlanesCli, RefusesFilesThatAreNotPcd)

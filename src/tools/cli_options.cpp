@@ -48,12 +48,29 @@ std::string number(double v)
 
 }  // namespace
 
+bool parseInteger(const std::string& text, int* out)
+{
+  std::istringstream in(text);
+  int v;
+  if (!(in >> v) || !in.eof()) return false;
+  *out = v;
+  return true;
+}
+
+bool parseFinite(const std::string& text, double* out)
+{
+  std::istringstream in(text);
+  double v;
+  if (!(in >> v) || !in.eof() || !std::isfinite(v)) return false;
+  *out = v;
+  return true;
+}
+
 bool setDetectorParam(DetectorParams& params, const std::string& name, const std::string& value, std::string* error)
 {
   for (const ParamEntry& entry : paramTable())
   {
     if (name != entry.name) continue;
-    std::istringstream in(value);
     if (name == "sensor_model")  // by name as well as by number
     {
       if (!parseSensorModel(value, &params.sensor_model))
@@ -63,25 +80,13 @@ bool setDetectorParam(DetectorParams& params, const std::string& name, const std
       }
       return true;
     }
-    if (entry.int_member)
+    if (entry.int_member ? !parseInteger(value, &(params.*entry.int_member))
+                         : !parseFinite(value, &(params.*entry.double_member)))
     {
-      int v;
-      if (!(in >> v) || !in.eof())
-      {
-        if (error) *error = "parameter " + name + " needs an integer, got '" + value + "'";
-        return false;
-      }
-      params.*entry.int_member = v;
-    }
-    else
-    {
-      double v;
-      if (!(in >> v) || !in.eof() || !std::isfinite(v))
-      {
-        if (error) *error = "parameter " + name + " needs a finite number, got '" + value + "'";
-        return false;
-      }
-      params.*entry.double_member = v;
+      if (error)
+        *error = "parameter " + name + (entry.int_member ? " needs an integer" : " needs a finite number") + ", got '" +
+                 value + "'";
+      return false;
     }
     return true;
   }

@@ -2,7 +2,6 @@
 // printed next to the true ones with the accuracy metrics and ms per frame.
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -19,14 +18,34 @@ int main(int argc, char** argv)
   double noise = 1.0;
   std::string scene_name = "office";
   DetectorParams params;
-  for (int i = 1; i + 1 < argc; i += 2)
+  for (int i = 1; i < argc; i += 2)
   {
-    const std::string name = std::string(argv[i]).substr(2), value = argv[i + 1];
+    const std::string flag = argv[i];
+    if (flag.rfind("--", 0) != 0 || i + 1 >= argc)
+    {
+      std::fprintf(stderr, "hough_demo: expected --NAME VALUE pairs, got '%s'\n", flag.c_str());
+      return 2;
+    }
+    const std::string name = flag.substr(2), value = argv[i + 1];
     std::string error;
-    if (name == "frames") frames = std::atoi(value.c_str());
-    else if (name == "noise") noise = std::atof(value.c_str());
-    else if (name == "scene") scene_name = value;
-    else if (!setDetectorParam(params, name, value, &error))
+    if (name == "frames")
+    {
+      if (!parseInteger(value, &frames) || frames < 1) error = "--frames needs a positive integer, got '" + value + "'";
+    }
+    else if (name == "noise")
+    {
+      if (!parseFinite(value, &noise) || noise < 0.0) error = "--noise needs a number >= 0, got '" + value + "'";
+    }
+    else if (name == "scene")
+    {
+      scene_name = value;
+      if (value != "office" && value != "hall") error = "--scene needs office or hall, got '" + value + "'";
+    }
+    else
+    {
+      setDetectorParam(params, name, value, &error);  // sets `error` when it refuses
+    }
+    if (!error.empty())
     {
       std::fprintf(stderr, "hough_demo: %s\n", error.c_str());
       return 2;

@@ -10,6 +10,10 @@
 namespace hough_plane_detector
 {
 
+// The whole text as an integer / a finite number; false (out untouched) for anything else ("12abc", "", "nan").
+bool parseInteger(const std::string& text, int* out);
+bool parseFinite(const std::string& text, double* out);
+
 // Sets the parameter `name` from text; false with `error` set for an unknown name or bad value.
 bool setDetectorParam(DetectorParams& params, const std::string& name, const std::string& value, std::string* error);
 // "name (type, default)" lines for --help.
