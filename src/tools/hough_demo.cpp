@@ -51,6 +51,12 @@ int main(int argc, char** argv)
       return 2;
     }
   }
+  const std::string invalid = params.validate();
+  if (!invalid.empty())
+  {
+    std::fprintf(stderr, "hough_demo: %s\n", invalid.c_str());
+    return 2;
+  }
   const Scene scene = scene_name == "hall" ? makeRampStairsHall() : makeOfficeRoom();
   SceneRenderer renderer(scene);
   PlaneDetector detector(params);
