@@ -36,3 +36,18 @@ TEST(PlaneMetrics, CountsMissesFalseAndDuplicateDetections)
   EXPECT_NEAR(m.d_errors[0], 0.004, 1e-9);
   EXPECT_NEAR(m.angle_errors[0], 0.0, 1e-9);
 }
+
+TEST(PlaneMetrics, AHiddenSurfaceOnTheSamePlaneDoesNotTakeTheVisibleOnesDetection)
+{
+  // A shelf board hidden in this frame at nearly a visible table's height: the detection lies
+  // closer to the board, yet it is the table's (the board is hidden, so it cannot count).
+  std::vector<TruePlane> truth = {{{0, 0, 1}, -0.75, "table_top"}, {{0, 0, 1}, -0.77, "shelf_board"}};
+  const std::vector<int> visible = {20000, 300};
+  const std::vector<EvaluatedPlane> detections = {{{0, 0, 1}, -0.765}};
+  const FrameMetrics m = evaluateFrame(truth, visible, 2000, detections);
+  EXPECT_EQ(m.visible, 1);
+  EXPECT_EQ(m.detected, 1);
+  EXPECT_EQ(m.false_detections, 0);
+  ASSERT_EQ(m.d_errors.size(), 1u);
+  EXPECT_NEAR(m.d_errors[0], 0.015, 1e-9);
+}

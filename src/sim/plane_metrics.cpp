@@ -23,18 +23,21 @@ FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std:
                            const MatchTolerance& tolerance)
 {
   FrameMetrics m;
-  std::vector<std::tuple<double, size_t, size_t>> pairs;  // cost, true, detection
+  auto isVisible = [&](size_t t) { return t < visible_points.size() && visible_points[t] >= min_visible_points; };
+  // Visible planes are matched first: a surface hidden in this frame that lies on the same plane
+  // as a visible one (a shelf board at a table's height) must not take the visible one's detection.
+  std::vector<std::tuple<bool, double, size_t, size_t>> pairs;  // hidden, cost, true, detection
   for (size_t t = 0; t < true_planes.size(); ++t)
     for (size_t k = 0; k < detections.size(); ++k)
     {
       const double ea = angleError(detections[k].normal, true_planes[t].normal);
       const double ed = distanceError(detections[k].normal, detections[k].d, true_planes[t].normal, true_planes[t].d);
       if (ea <= tolerance.angle && ed <= tolerance.distance)
-        pairs.emplace_back(ea / tolerance.angle + ed / tolerance.distance, t, k);
+        pairs.emplace_back(!isVisible(t), ea / tolerance.angle + ed / tolerance.distance, t, k);
     }
   std::sort(pairs.begin(), pairs.end());
   std::vector<int> true_match(true_planes.size(), -1), detection_match(detections.size(), -1);
-  for (const auto& [cost, t, k] : pairs)
+  for (const auto& [hidden, cost, t, k] : pairs)
   {
     if (true_match[t] >= 0 || detection_match[k] >= 0) continue;
     true_match[t] = static_cast<int>(k);
@@ -42,7 +45,7 @@ FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std:
   }
   for (size_t t = 0; t < true_planes.size(); ++t)
   {
-    if (t >= visible_points.size() || visible_points[t] < min_visible_points) continue;
+    if (!isVisible(t)) continue;
     ++m.visible;
     if (true_match[t] < 0)
     {

@@ -38,8 +38,8 @@ double angleError(const Eigen::Vector3d& normal, const Eigen::Vector3d& true_nor
 // E_d after aligning the sign of the normal with the true one.
 double distanceError(const Eigen::Vector3d& normal, double d, const Eigen::Vector3d& true_normal, double true_d);
 
-// One-to-one matching (closest pairs first) of detections to all true planes of the scene;
-// planes with at least min_visible_points count as visible.
+// One-to-one matching (closest pairs first, visible planes before hidden ones) of detections to all
+// true planes of the scene; planes with at least min_visible_points count as visible.
 FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std::vector<int>& visible_points,
                            int min_visible_points, const std::vector<EvaluatedPlane>& detections,
                            const MatchTolerance& tolerance = MatchTolerance());
