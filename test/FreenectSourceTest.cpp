@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -125,6 +126,31 @@ TEST(FreenectSource, AMissingRecordingIsAClearErrorNotACrash)
   const std::string output = playThroughFreenectSource("/tmp/hough_plane_detector_no_such_dump", 3.0);
   EXPECT_NE(output.find("has no readable INDEX.txt"), std::string::npos) << output;
   EXPECT_EQ(output.find("Cannot open file"), std::string::npos) << "fakenect was reached: " << output;
+}
+
+TEST(FreenectSource, ARecordingThatEndsMidFrameIsAClearErrorNotAFrame)
+{
+  // A dump whose last depth file was cut (the recorder killed while writing) is refused with the
+  // file named; fakenect would hand on whatever the cut file holds.
+  const std::string whole = "/tmp/hough_plane_detector_fakenect", cut = "/tmp/hough_plane_detector_fakenect_cut";
+  writeFakenectDump(whole);
+  mkdir(cut.c_str(), 0755);
+  std::ifstream index(whole + "/INDEX.txt");
+  std::ofstream cut_index(cut + "/INDEX.txt");
+  std::string name, last;
+  for (int f = 0; f < 3 && std::getline(index, name); ++f)
+  {
+    std::ifstream from(whole + "/" + name, std::ios::binary);
+    std::ofstream(cut + "/" + name, std::ios::binary) << from.rdbuf();
+    cut_index << name << "\n";
+    last = name;
+  }
+  cut_index.close();
+  ASSERT_EQ(truncate((cut + "/" + last).c_str(), 300000), 0);
+  const std::string output = playThroughFreenectSource(cut, 3.0);
+  EXPECT_NE(output.find(last + " holds 300000 of its 614417 bytes"), std::string::npos) << output;
+  EXPECT_NE(output.find("INDEX.txt line 3"), std::string::npos) << output;
+  EXPECT_EQ(output.find("streaming depth"), std::string::npos) << "fakenect was reached: " << output;
 }
 
 int main(int argc, char** argv)

@@ -62,16 +62,50 @@ private:
                  getNodeHandle().resolveName("depth/points").c_str());
   }
 
-  // fakenect ends the whole process when its recording is missing: refuse it here instead.
+  // fakenect ends the whole process when its recording is missing and hands on whatever a cut
+  // frame file holds: both are refused here, before fakenect reads them.
   bool fakenectRecordingReadable()
   {
     const char* path = std::getenv("FAKENECT_PATH");
     if (!path) return true;
-    const std::string index = std::string(path) + "/INDEX.txt";
-    if (std::ifstream(index).good()) return true;
-    NODELET_ERROR("FAKENECT_PATH=%s has no readable INDEX.txt (a fakenect-record dump): no depth will be published.",
-                  path);
-    return false;
+    std::ifstream index(std::string(path) + "/INDEX.txt");
+    if (!index.good())
+    {
+      NODELET_ERROR("FAKENECT_PATH=%s has no readable INDEX.txt (a fakenect-record dump): no depth will be published.",
+                    path);
+      return false;
+    }
+    std::string name;
+    for (int line = 1; std::getline(index, name); ++line)
+    {
+      if (name.compare(0, 2, "d-") != 0) continue;  // depth frames; r- (colour) and a- (accelerometer) are not read
+      const std::string problem = checkDepthFrameFile(std::string(path) + "/" + name);
+      if (problem.empty()) continue;
+      NODELET_ERROR("FAKENECT_PATH=%s: %s (INDEX.txt line %d); the recording ends mid-frame or is damaged, so no "
+                    "depth will be published (cut INDEX.txt before that line to play the frames before it).",
+                    path, problem.c_str(), line);
+      return false;
+    }
+    return true;
+  }
+
+  // Empty when `file` is a whole fakenect depth frame: a "P5 <w> <h> <max>" header and w x h
+  // 16-bit samples.
+  static std::string checkDepthFrameFile(const std::string& file)
+  {
+    std::ifstream in(file, std::ios::binary | std::ios::ate);
+    if (!in.good()) return file + " cannot be read";
+    const std::streamoff size = in.tellg();
+    in.seekg(0);
+    std::string magic;
+    long width = 0, height = 0, max_value = 0;
+    if (!(in >> magic >> width >> height >> max_value) || magic != "P5" || width <= 0 || height <= 0 || max_value <= 255)
+      return file + " has no 16-bit PGM header (P5 <width> <height> <max>)";
+    in.get();  // the one whitespace after the header
+    const std::streamoff expected = in.tellg() + std::streamoff(width) * height * 2;
+    if (size < expected)
+      return file + " holds " + std::to_string(size) + " of its " + std::to_string(expected) + " bytes";
+    return std::string();
   }
 
   bool openDevice(int device_index)
