@@ -42,7 +42,7 @@ all: build
 help:
 	@echo "make deps          install the Debian packages the build, tests and demo need (safe to rerun)"
 	@echo "make build         build the catkin workspace in build/ws (Release)"
-	@echo "make test          build and run every gtest, rostest and fuzz smoke run; prints N passed, N failed"
+	@echo "make test          build and run every gtest, rostest, fuzz smoke run and the install-space rostest; prints N passed, N failed"
 	@echo "make test SANITIZE=address,undefined   the same with sanitizers, in its own workspace"
 	@echo "make tsan          ThreadSanitizer on the nodelet under concurrent clouds, reconfigure and services"
 	@echo "make tsan-control  the same on a build that skips the map lock (must report races)"
@@ -73,6 +73,7 @@ test: build
 	@grep -E "^\[ *(RUN|OK|FAILED|PASSED) *\]|Failure|error:|runtime error|ERROR: AddressSanitizer" $(WS)/run_tests.log | grep -v "^\[ *RUN" || true
 	@if [ -n "$(SANITIZE)" ]; then scripts/run_sanitized_gtests.sh $(CURDIR)/$(WS); fi
 	@if [ -z "$(SANITIZE)" ]; then scripts/run_fuzzers.sh smoke $(CURDIR)/$(WS)/build/test_results/fuzz || true; fi
+	@if [ -z "$(SANITIZE)" ]; then scripts/test_install_space.sh $(CURDIR)/$(WS) $(CURDIR)/$(WS)/build/test_results/install_space || true; fi
 	@scripts/test_summary.py $(WS)/build/test_results
 
 # ThreadSanitizer over the running nodelet: test/concurrency.test (clouds, reconfigure and
