@@ -2,6 +2,8 @@
 // VGA as depth/image_raw (16UC1 mm), depth/camera_info and the organized depth/points, with
 // openni2_camera's names, stamped from the device's frame timestamps. Run under fakenect
 // (LD_LIBRARY_PATH=<libdir>/fakenect FAKENECT_PATH=<dump>) it plays a recording instead.
+#include <dlfcn.h>
+
 #include <atomic>
 #include <cstdlib>
 #include <fstream>
@@ -9,6 +11,7 @@
 #include <vector>
 
 #include <libfreenect.h>
+#include <libfreenect_registration.h>
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
@@ -41,11 +44,6 @@ private:
     int device_index;
     private_nh.param("device_index", device_index, 0);
     private_nh.param<std::string>("frame_id", frame_id_, "camera_depth_optical_frame");
-    // The Kinect's nominal depth-camera projection; ~fx.. override it with a calibration.
-    private_nh.param("fx", intrinsics_.fx, intrinsics_.fx);
-    private_nh.param("fy", intrinsics_.fy, intrinsics_.fy);
-    private_nh.param("cx", intrinsics_.cx, intrinsics_.cx);
-    private_nh.param("cy", intrinsics_.cy, intrinsics_.cy);
     private_nh.param("device_clock_hz", device_clock_hz_, 60.0e6);
     if (!(device_clock_hz_ > 0.0))
     {
@@ -56,6 +54,16 @@ private:
     publisher_.advertise(getNodeHandle());
     if (!fakenectRecordingReadable()) return;
     if (!openDevice(device_index)) return;
+    // The projection: the device's own focal length (its registration data), unless ~fx.. give
+    // a calibration.
+    const std::string focal_from = deviceFocalLength();
+    private_nh.param("fx", intrinsics_.fx, intrinsics_.fx);
+    private_nh.param("fy", intrinsics_.fy, intrinsics_.fy);
+    private_nh.param("cx", intrinsics_.cx, intrinsics_.cx);
+    private_nh.param("cy", intrinsics_.cy, intrinsics_.cy);
+    NODELET_INFO("Kinect v1 %d depth projection: fx %.1f fy %.1f cx %.1f cy %.1f px (%s).", device_index,
+                 intrinsics_.fx, intrinsics_.fy, intrinsics_.cx, intrinsics_.cy,
+                 private_nh.hasParam("fx") ? "~fx.. given" : focal_from.c_str());
     running_ = true;
     reader_ = std::thread([this] { readLoop(); });
     NODELET_INFO("Kinect v1 %d streaming depth (640 x 480, 11-bit disparity) on %s.", device_index,
@@ -143,6 +151,28 @@ private:
       return false;
     }
     return true;
+  }
+
+  // Sets fx = fy from the device's zero-plane data, as libfreenect's own freenect_camera_to_world
+  // does (a pixel of reference_pixel_size mm at SXGA, so twice that at VGA, seen reference_distance
+  // mm away); says where the focal length came from. Looked up at run time: fakenect's
+  // libfreenect has no registration, and a direct call would keep the nodelet from loading there.
+  std::string deviceFocalLength()
+  {
+    using CopyRegistration = freenect_registration (*)(freenect_device*);
+    using DestroyRegistration = int (*)(freenect_registration*);
+    const auto copy = reinterpret_cast<CopyRegistration>(dlsym(RTLD_DEFAULT, "freenect_copy_registration"));
+    const auto destroy = reinterpret_cast<DestroyRegistration>(dlsym(RTLD_DEFAULT, "freenect_destroy_registration"));
+    if (!copy || !destroy) return "nominal: this libfreenect (fakenect?) has no registration data";
+    freenect_registration registration = copy(device_);
+    const double distance = registration.zero_plane_info.reference_distance;
+    const double pixel = registration.zero_plane_info.reference_pixel_size;
+    destroy(&registration);
+    const double focal = distance / (2.0 * pixel);
+    if (!(distance > 0.0 && pixel > 0.0 && focal > 100.0 && focal < 2000.0))
+      return "nominal: the device's registration data gave no usable focal length";
+    intrinsics_.fx = intrinsics_.fy = focal;
+    return "the device's registration data";
   }
 
   void readLoop()
