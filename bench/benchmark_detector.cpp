@@ -152,8 +152,7 @@ int main(int argc, char** argv)
         }
         CloudView view;
         std::vector<float> converted;
-        error = makeCloudView(layoutOf(blob), view, converted);
-        if (!error.empty() || !real.processFrame(view, Eigen::Isometry3d::Identity(), rep * argc + i, &error))
+        if (!makeCloudView(layoutOf(blob), view, converted, &error) || !real.processFrame(view, Eigen::Isometry3d::Identity(), rep * argc + i, &error))
         {
           std::fprintf(stderr, "%s: %s\n", argv[i], error.c_str());
           return 1;

@@ -742,7 +742,7 @@ bool realFrames(Report& report, const std::vector<std::string>& paths)
     std::string error;
     CloudView view;
     std::vector<float> converted;
-    if (!loadPcd(paths[i], blob, &error) || !(error = makeCloudView(layoutOf(blob), view, converted)).empty())
+    if (!loadPcd(paths[i], blob, &error) || !makeCloudView(layoutOf(blob), view, converted, &error))
     {
       std::fprintf(stderr, "%s: %s\n", paths[i].c_str(), error.c_str());
       return false;

@@ -56,7 +56,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
   layout.data_size = buffer.size();
   CloudView view;
   std::vector<float> converted;
-  if (!makeCloudView(layout, view, converted).empty()) return 0;
+  if (!makeCloudView(layout, view, converted)) return 0;
   std::string error;
   detector->processFrame(view, Eigen::Isometry3d::Identity(), 0.0, &error);
   return 0;

@@ -182,9 +182,11 @@ TEST(PlaneDetector, RefusesAWindowScaleOtherThanOneTwoOrFour)
 {
   DetectorParams params;
   params.max_window_scale = 3;
-  EXPECT_NE(params.validate().find("max_window_scale"), std::string::npos);
+  std::string error;
+  EXPECT_FALSE(params.validate(&error));
+  EXPECT_NE(error.find("max_window_scale"), std::string::npos) << error;
   params.max_window_scale = 2;
-  EXPECT_EQ(params.validate(), "");
+  EXPECT_TRUE(params.validate());
 }
 
 // One large plane of the given orientation, seen head-on-ish from 2.5 m, three noisy frames:

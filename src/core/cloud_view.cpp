@@ -48,7 +48,10 @@ float readField(const uint8_t* p, uint8_t datatype)
 }
 }  // namespace
 
-std::string makeCloudView(const PointBufferLayout& layout, CloudView& view, std::vector<float>& converted)
+namespace
+{
+// What is wrong with the buffer (empty: nothing), making the view on the way.
+std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vector<float>& converted)
 {
   std::ostringstream err;
   if (layout.width == 0 || layout.height == 0)
@@ -130,6 +133,15 @@ std::string makeCloudView(const PointBufferLayout& layout, CloudView& view, std:
   view.y_offset = 4;
   view.z_offset = 8;
   return "";
+}
+}  // namespace
+
+bool makeCloudView(const PointBufferLayout& layout, CloudView& view, std::vector<float>& converted, std::string* error)
+{
+  const std::string problem = viewCloud(layout, view, converted);
+  if (problem.empty()) return true;
+  if (error) *error = problem;
+  return false;
 }
 
 }  // namespace hough_plane_detector

@@ -23,7 +23,7 @@ double DetectorParams::effectiveDStep() const
   return resolution > 0 ? 10.0 / resolution : d_step;
 }
 
-std::string DetectorParams::validate() const
+bool DetectorParams::validate(std::string* error) const
 {
   std::ostringstream err;
   if (resolution != 0 && resolution != 256 && resolution != 512 && resolution != 1024 && resolution != 2048)
@@ -70,8 +70,10 @@ std::string DetectorParams::validate() const
   if (region_growing != 0 && region_growing != 1) err << "region_growing must be 0 or 1, got " << region_growing << "; ";
   if (forgetting != 0 && forgetting != 1) err << "forgetting must be 0 (thinning) or 1 (evidence), got " << forgetting << "; ";
   std::string s = err.str();
-  if (s.size() >= 2) s.resize(s.size() - 2);
-  return s;
+  if (s.empty()) return true;
+  s.resize(s.size() - 2);
+  if (error) *error = s;
+  return false;
 }
 
 }  // namespace hough_plane_detector

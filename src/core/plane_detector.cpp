@@ -28,8 +28,8 @@ int marginCells(const DetectorParams& p)
 // Throws before any member is built from bad values (a zero step would size the space at infinity).
 const DetectorParams& validated(const DetectorParams& params)
 {
-  const std::string problem = params.validate();
-  if (!problem.empty()) throw std::invalid_argument("invalid detector parameters: " + problem);
+  std::string problem;
+  if (!params.validate(&problem)) throw std::invalid_argument("invalid detector parameters: " + problem);
   return params;
 }
 
@@ -194,17 +194,12 @@ bool PlaneDetector::sameGrid(const DetectorParams& a, const DetectorParams& b)
          a.max_distance == b.max_distance && a.blur_kernel_size == b.blur_kernel_size && a.peak_window == b.peak_window;
 }
 
-bool PlaneDetector::updateParams(const DetectorParams& params, std::string* why)
+bool PlaneDetector::updateParams(const DetectorParams& params, std::string* error)
 {
-  const std::string problem = params.validate();
-  if (!problem.empty())
-  {
-    if (why) *why = problem;
-    return false;
-  }
+  if (!params.validate(error)) return false;
   if (!sameGrid(params, params_))
   {
-    if (why) *why = "the Hough grid changes";
+    if (error) *error = "the Hough grid changes";
     return false;
   }
   params_ = params;

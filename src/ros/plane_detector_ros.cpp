@@ -97,8 +97,8 @@ void PlaneDetectorRos::readParameters(ros::NodeHandle& private_nh)
 #define HPD_READ(type, name) private_nh.param(#name, params_.name, defaults.name);
   HOUGH_PLANE_DETECTOR_PARAMS(HPD_READ)
 #undef HPD_READ
-  const std::string problem = params_.validate();
-  if (!problem.empty())
+  std::string problem;
+  if (!params_.validate(&problem))
   {
     ROS_ERROR_NAMED(name_, "Invalid detector parameters (%s); using the defaults.", problem.c_str());
     params_ = DetectorParams();
@@ -226,7 +226,8 @@ void PlaneDetectorRos::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& clo
   // The message is read in place (float32 x/y/z) and never modified.
   CloudView view;
   std::vector<float> converted;
-  std::string error = makeCloudView(layoutOf(*cloud), view, converted);
+  std::string error;
+  const bool viewable = makeCloudView(layoutOf(*cloud), view, converted, &error);
 
   const auto lock = lockMap();
   // The subscriber queue drops the oldest clouds when the detector falls behind; drivers
@@ -235,8 +236,7 @@ void PlaneDetectorRos::cloudCallback(const sensor_msgs::PointCloud2ConstPtr& clo
   last_seq_ = cloud->header.seq;
   arrivals_.push_back(ros::WallTime::now());
   while (arrivals_.size() > 30) arrivals_.pop_front();
-  if (error.empty()) detector_->processFrame(view, camera_to_world, cloud->header.stamp.toSec(), &error);
-  if (!error.empty())
+  if (!viewable || !detector_->processFrame(view, camera_to_world, cloud->header.stamp.toSec(), &error))
   {
     ++frames_rejected_;
     ROS_ERROR_THROTTLE_NAMED(5.0, name_, "Cloud from '%s' refused: %s", cloud->header.frame_id.c_str(), error.c_str());
@@ -298,8 +298,8 @@ void PlaneDetectorRos::reconfigure(HoughPlaneDetectorConfig& config, uint32_t /*
 {
   const DetectorParams requested = toParams(config);
   const auto lock = lockMap();
-  const std::string problem = requested.validate();
-  if (!problem.empty())
+  std::string problem;
+  if (!requested.validate(&problem))
   {
     ROS_ERROR_NAMED(name_, "Reconfigure refused: %s; keeping the current parameters.", problem.c_str());
     config = toConfig(params_);

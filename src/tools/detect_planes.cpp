@@ -81,8 +81,8 @@ int main(int argc, char** argv)
     std::cerr << "detect_planes: --bag needs --topic\n";
     return 2;
   }
-  const std::string problem = params.validate();
-  if (!problem.empty())
+  std::string problem;
+  if (!params.validate(&problem))
   {
     std::cerr << "detect_planes: invalid parameters: " << problem << "\n";
     return 2;
@@ -106,9 +106,8 @@ int main(int argc, char** argv)
                  const std::string& frame_id, const std::string& what) {
     CloudView view;
     std::vector<float> converted;
-    std::string error = makeCloudView(layout, view, converted);
-    if (error.empty() && !detector.processFrame(view, pose, stamp, &error)) {}
-    if (!error.empty())
+    std::string error;
+    if (!makeCloudView(layout, view, converted, &error) || !detector.processFrame(view, pose, stamp, &error))
     {
       std::cerr << "detect_planes: " << what << ": " << error << "\n";
       ++frame_index;

@@ -51,8 +51,8 @@ int main(int argc, char** argv)
       return 2;
     }
   }
-  const std::string invalid = params.validate();
-  if (!invalid.empty())
+  std::string invalid;
+  if (!params.validate(&invalid))
   {
     std::fprintf(stderr, "hough_demo: %s\n", invalid.c_str());
     return 2;

@@ -78,8 +78,9 @@ PointBufferLayout layoutOfCloud(const Cloud& cloud)
 }
 
 // Checks the layout and makes a view of it. Float32 x/y/z are viewed in place; other numeric
-// types are converted into `converted`, which must outlive the view. Returns an empty string
-// on success, otherwise what is wrong with the buffer.
-std::string makeCloudView(const PointBufferLayout& layout, CloudView& view, std::vector<float>& converted);
+// types are converted into `converted`, which must outlive the view. Returns false, with what is
+// wrong with the buffer in `error`, when it cannot be viewed.
+bool makeCloudView(const PointBufferLayout& layout, CloudView& view, std::vector<float>& converted,
+                   std::string* error = nullptr);
 
 }  // namespace hough_plane_detector

@@ -125,8 +125,8 @@ struct DetectorParams
   // 0 = thinning (paper 3.7: every cell loses thinning_rate per frame; Fig. 6-8 use it).
   int forgetting = 1;
 
-  // Returns an empty string when the combination is valid, otherwise what is wrong.
-  std::string validate() const;
+  // True when the combination is valid; otherwise false, with what is wrong in `error`.
+  bool validate(std::string* error = nullptr) const;
   // Angle and d steps after applying the preset.
   double effectiveAngleStep() const;
   double effectiveDStep() const;

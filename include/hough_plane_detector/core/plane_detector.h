@@ -4,6 +4,10 @@
 // block_regions), the parallel-plane search (parallel_planes), the persistent map with its
 // thinning, ids, extents and evidence (plane_map), and the frame's labels (frame_labels).
 // PlaneDetector runs them in order on each frame and times each.
+//
+// Errors, throughout the core: what can fail on input returns bool, false with the reason in a
+// `std::string* error` (which may be null) and nothing changed. Only the constructor throws, for
+// parameters its caller did not validate first (a programming error, not bad input).
 #pragma once
 
 #include <cstdint>
@@ -69,7 +73,7 @@ struct FrameStats
 class PlaneDetector
 {
 public:
-  // Throws std::invalid_argument naming the problem when params.validate() fails.
+  // Precondition: params.validate(); throws std::invalid_argument naming the problem otherwise.
   explicit PlaneDetector(const DetectorParams& params);
   // The stages keep references to the detector's own parameters and frame: it stays where it
   // was built (hold it by std::unique_ptr to move it).
@@ -120,7 +124,7 @@ public:
   // Parameters that keep the Hough grid (everything but resolution, angle_step, d_step,
   // max_distance, blur_kernel_size, peak_window) change in place; returns false, changing
   // nothing, when the new ones need a new detector (and an empty map) or are invalid.
-  bool updateParams(const DetectorParams& params, std::string* why);
+  bool updateParams(const DetectorParams& params, std::string* error);
   static bool sameGrid(const DetectorParams& a, const DetectorParams& b);
 
   // Forgets every plane and empties the global space.
