@@ -59,9 +59,7 @@ int main(int argc, char** argv)
       for (int i = 0; i < kStages; ++i) stage[i].push_back(values[i]);
       ours.ms.push_back(t.total_ms);
       if (lap == 0 && f < 3) continue;
-      std::vector<EvaluatedPlane> evaluated;
-      for (const auto& p : detector.planes()) evaluated.push_back({p.normal, p.d});
-      ours.add(evaluateFrame(renderer.truePlanes(), rendered[f].visible_points, 2000, evaluated));
+      ours.add(evaluateFrame(renderer.truePlanes(), rendered[f].visible_points, 2000, evaluatedPlanes(detector.planes())));
     }
   const char* names[kStages] = {"normals", "voting",     "blur",         "local peaks",   "per-frame fits",
                                  "parallel search", "map update", "labels + extents", "total"};

@@ -70,13 +70,6 @@ DetectorParams paperParamsFor(double noise, int resolution)
   return p;
 }
 
-std::vector<EvaluatedPlane> mapPlanes(const PlaneDetector& detector)
-{
-  std::vector<EvaluatedPlane> out;
-  for (const auto& p : detector.planes()) out.push_back({p.normal, p.d});
-  return out;
-}
-
 struct Comparators
 {
   MethodStats ransac, organized;
@@ -188,7 +181,7 @@ void noiseExperiments(Report& report)
         }
         if (f >= kWarmupFrames && (f - kWarmupFrames) % stride == 0)
           ours[r].add(evaluateFrame(renderer.truePlanes(), rendered[f].visible_points, kMinVisiblePoints,
-                                    mapPlanes(detector)));
+                                    evaluatedPlanes(detector.planes())));
       }
     }
     Comparators pcl;
@@ -281,7 +274,7 @@ void wallApproachExperiment(Report& report)
     detector.processFrame(rendered[f].view(), rendered[f].camera_to_world, 0.1 * f);
     const auto cloud = toPclCloud(rendered[f].view());
     const double distances[3] = {
-        wallDistance(mapPlanes(detector), eye),
+        wallDistance(evaluatedPlanes(detector.planes()), eye),
         wallDistance(planesToWorld(pclRansacPlanes(cloud, ransac_iterations, ransacThreshold(noise), kMinVisiblePoints),
                                    rendered[f].camera_to_world),
                      eye),
@@ -418,7 +411,7 @@ TourResult runTour(const Scene& scene, const std::vector<Eigen::Isometry3d>& pos
     detector.processFrame(rendered[f].view(), rendered[f].camera_to_world, 0.1 * f);
     result.ours.ms.push_back(detector.lastTimings().total_ms);
     if (static_cast<int>(f) < kWarmupFrames || (static_cast<int>(f) - kWarmupFrames) % stride != 0) continue;
-    const FrameMetrics metrics = evaluateFrame(truth, rendered[f].visible_points, kMinVisiblePoints, mapPlanes(detector));
+    const FrameMetrics metrics = evaluateFrame(truth, rendered[f].visible_points, kMinVisiblePoints, evaluatedPlanes(detector.planes()));
     result.ours.add(metrics);
     for (size_t t = 0; t < truth.size(); ++t)
       if (rendered[f].visible_points[t] >= kMinVisiblePoints) ++result.tally.visible_frames[static_cast<int>(t)];
@@ -682,7 +675,7 @@ void randomSceneExperiment(Report& report)
       for (auto& detector : detectors) detector->processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
       if (f < kWarmupFrames || (f - kWarmupFrames) % 3 != 0) continue;
       for (size_t v = 0; v < variants.size(); ++v)
-        stats[v].add(evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints, mapPlanes(*detectors[v])));
+        stats[v].add(evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints, evaluatedPlanes(detectors[v]->planes())));
     }
     if (row)
       rows += fmt("| %u | %s | %.1f %% | %.2f | %.1f %% | %.2f |\n", seed, room.description.c_str(),

@@ -73,9 +73,8 @@ TourScore tourOffice(PlaneDetector& detector, const SceneRenderer& renderer, dou
     const RenderedFrame frame = renderer.render(poses[f], kinect(c), seed + f);
     feed(detector, frame, 0.1 * f);
     if (f < 3) continue;
-    std::vector<EvaluatedPlane> evaluated;
-    for (const auto& p : detector.planes()) evaluated.push_back({p.normal, p.d});
-    const FrameMetrics m = evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluated);
+    const FrameMetrics m =
+        evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluatedPlanes(detector.planes()));
     ++score.frames;
     score.visible += m.visible;
     score.detected += m.detected;
@@ -454,9 +453,8 @@ TEST(PlaneDetector, NearlyLevelPlanesTakeTheFloorsNormalInsteadOfATiltedTwin)
       const RenderedFrame frame = renderer.render(poses[f], kinect(1.0), 900 + f);
       feed(detector, frame, 0.1 * f);
       if (f < 3 || (f - 3) % 3 != 0) continue;
-      std::vector<EvaluatedPlane> planes;
-      for (const auto& p : detector.planes()) planes.push_back({p.normal, p.d});
-      const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, planes);
+      const FrameMetrics metrics =
+          evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluatedPlanes(detector.planes()));
       visible += metrics.visible;
       detected += metrics.detected;
       *false_planes += metrics.false_detections;
@@ -499,9 +497,8 @@ TEST(PlaneDetector, TheLabTourHasNoPlaneOnABin)
     const RenderedFrame frame = renderer.render(poses[f], kinect(1.0), 11000 + f);
     feed(detector, frame, 0.1 * f);
     if (f < 3 || (f - 3) % 3 != 0) continue;
-    std::vector<EvaluatedPlane> planes;
-    for (const auto& p : detector.planes()) planes.push_back({p.normal, p.d});
-    const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, planes);
+    const FrameMetrics metrics =
+        evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluatedPlanes(detector.planes()));
     EXPECT_EQ(metrics.false_detections, 0) << "frame " << f << describe(detector.planes());
     visible += metrics.visible;
     detected += metrics.detected;

@@ -18,6 +18,14 @@ double distanceError(const Eigen::Vector3d& normal, double d, const Eigen::Vecto
   return std::abs(sign * d - true_d);
 }
 
+std::vector<EvaluatedPlane> evaluatedPlanes(const std::vector<DetectedPlane>& planes)
+{
+  std::vector<EvaluatedPlane> out;
+  out.reserve(planes.size());
+  for (const DetectedPlane& plane : planes) out.push_back({plane.normal, plane.d});
+  return out;
+}
+
 FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std::vector<int>& visible_points,
                            int min_visible_points, const std::vector<EvaluatedPlane>& detections,
                            const MatchTolerance& tolerance)

@@ -79,9 +79,8 @@ int main(int argc, char** argv)
       return 1;
     }
     ms.push_back(detector.lastTimings().total_ms);
-    std::vector<EvaluatedPlane> evaluated;
-    for (const auto& p : detector.planes()) evaluated.push_back(EvaluatedPlane{p.normal, p.d});
-    const FrameMetrics m = evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluated);
+    const FrameMetrics m =
+        evaluateFrame(renderer.truePlanes(), frame.visible_points, 2000, evaluatedPlanes(detector.planes()));
     const FrameStats& st = detector.lastStats();
     std::printf("%5d  %5.2f  %6zu  %7d  %5d  %5d   (windows %d, planar %d, cache cells %d, local peaks %d)\n", f,
                 detector.lastTimings().total_ms, detector.planes().size(), m.visible, m.detected, m.false_detections,

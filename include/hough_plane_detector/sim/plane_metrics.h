@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "hough_plane_detector/core/detected_plane.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
 
 namespace hough_plane_detector
@@ -15,6 +16,9 @@ struct EvaluatedPlane
   Eigen::Vector3d normal;
   double d;
 };
+
+// A detector's map planes as the metrics score them (world frame).
+std::vector<EvaluatedPlane> evaluatedPlanes(const std::vector<DetectedPlane>& planes);
 
 struct MatchTolerance
 {
