@@ -15,17 +15,12 @@
 #include "hough_plane_detector/core/sensor_model.h"
 #include "hough_plane_detector/tools/input_sources.h"
 #include "pcl_comparators.h"
+#include "stopwatch.h"
 
 using namespace hough_plane_detector;
-using Clock = std::chrono::steady_clock;
 
 namespace
 {
-double msSince(Clock::time_point t)
-{
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
-
 void printStats(const MethodStats& s, const char* name)
 {
   std::printf("  %-34s %8.2f %8.2f %8.2f   %.4f   %.4f   %5.1f %%   %.2f\n", name, median(s.ms), percentile(s.ms, 0.1),
@@ -96,9 +91,9 @@ int main(int argc, char** argv)
   std::vector<double> intrinsics_ms;
   for (int f = 0; f < frames; ++f)
   {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     const PinholeIntrinsics k = estimateIntrinsics(rendered[f].view());
-    intrinsics_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    intrinsics_ms.push_back(msSince(start));
     if (!k.valid()) std::printf("  no projection fitted to frame %d\n", f);
   }
   std::printf("  of the normals: the projection fitted to the cloud %.3f ms\n", median(intrinsics_ms));

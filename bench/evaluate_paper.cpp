@@ -28,9 +28,9 @@
 #include "hough_plane_detector/sim/random_scene.h"
 #include "osd_learn.h"
 #include "pcl_comparators.h"
+#include "stopwatch.h"
 
 using namespace hough_plane_detector;
-using Clock = std::chrono::steady_clock;
 
 namespace
 {
@@ -38,11 +38,6 @@ constexpr int kMinVisiblePoints = 2000;  // planes smaller in a frame are neithe
 constexpr int kWarmupFrames = 3;         // our map needs global_threshold frames before it reports
 const double kNoiseLevels[] = {0.0, 0.3, 1.0, 4.0};
 const int kResolutions[] = {512, 1024, 2048};
-
-double msSince(Clock::time_point t)
-{
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 // The paper tuned RANSAC's inlier threshold to the noise: 0.01 m on clean data up to 0.05 m.
 double ransacThreshold(double noise)

@@ -14,13 +14,13 @@
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/tools/png_image.h"
 #include "pcl_comparators.h"
+#include "stopwatch.h"
 
 namespace hough_plane_detector
 {
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
 constexpr double kMatchAngle = 0.06;      // rad, the data set's protocol
 constexpr double kMatchDistance = 0.03;   // m
 constexpr int kPclMinInliers = 1500;      // as the data set's README measured PCL
@@ -35,11 +35,6 @@ struct Entry
   int points;
   int object;  // 0 for the table, else the object's label / 10 (obj20 -> 2)
 };
-
-double msSince(Clock::time_point t)
-{
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 bool matches(const Eigen::Vector3d& n, double d, const Entry& e, double* angle = nullptr, double* distance = nullptr)
 {
