@@ -1,0 +1,143 @@
+// The paper's section 4 as experiments that return their measurements (evaluate_paper.cpp
+// writes them as RESULTS.md and gnuplot data): Hough-space memory and accuracy against noise
+// (Fig. 6, 7), a wall approach (Fig. 8), Kinect-like room tours with timing (Table 3, 4.6.4),
+// the same scenes along other paths, the per-frame stage and forgetting variants, procedural
+// rooms with held-out seeds and the real frames of kinect-real. PCL RANSAC and PCL OMPS run on
+// the same frames in this process.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "hough_plane_detector/core/detected_plane.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
+#include "pcl_comparators.h"
+
+namespace hough_plane_detector
+{
+
+constexpr int kMinVisiblePoints = 2000;  // planes smaller in a frame are neither expected nor counted
+constexpr int kWarmupFrames = 3;         // our map needs global_threshold frames before it reports
+constexpr int kResolutionCount = 3;
+extern const int kResolutions[kResolutionCount];  // Fig. 7's Hough resolutions
+
+// The paper tuned RANSAC's inlier threshold to the noise: 0.01 m on clean data up to 0.05 m.
+double ransacThreshold(double noise);
+
+// Fig. 6 and 7: the office tour at one noise level C.
+struct NoiseLevelResult
+{
+  double noise = 0.0;
+  std::array<MethodStats, kResolutionCount> ours;  // by kResolutions
+  MethodStats ransac, organized;
+  double final_mb = 0.0, peak_mb = 0.0;  // the 1024 space after the run, and its largest
+  size_t final_chunks = 0;
+  double final_dense_share = 0.0;  // of the dense array
+};
+struct NoiseExperiment
+{
+  int frames = 0, stride = 0, ransac_iterations = 0;
+  std::vector<NoiseLevelResult> levels;
+  std::vector<std::vector<double>> memory_mb;  // per frame, per level: the 1024 space's MB
+  double dense_mb = 0.0;
+};
+NoiseExperiment runNoiseExperiment(bool quick);
+
+// Fig. 8: a camera driving at a wall; per frame the distance each method's wall plane gives.
+struct WallExperiment
+{
+  int frames = 0, ransac_iterations = 0;
+  double noise = 0.0;
+  std::vector<double> truth;                  // per frame, m
+  std::vector<std::array<double, 3>> found;  // per frame: ours, RANSAC, OMPS (NaN: no wall plane)
+};
+WallExperiment runWallApproach(bool quick);
+
+// What our map missed in a tour: frames each true plane was visible, and per plane the causes.
+struct MissTally
+{
+  std::map<int, int> visible_frames;                        // per true plane
+  std::map<int, std::map<std::string, int>> ours_causes;  // per true plane: cause -> frames
+};
+
+struct TourResult
+{
+  std::vector<TruePlane> truth;  // the scene's
+  MethodStats ours, ransac, organized;
+  MissTally tally;
+};
+
+// Table 3 and 4.6.4: tours of the three scenes at C = 1; timing from the same runs.
+struct SceneTour
+{
+  std::string scene;
+  TourResult tour;
+};
+struct RoomExperiment
+{
+  int frames = 0, stride = 0, ransac_iterations = 0;
+  double noise = 0.0, ransac_threshold = 0.0;
+  std::vector<SceneTour> scenes;
+  std::map<std::string, int> causes;  // our misses over all scenes, by cause
+};
+RoomExperiment runRoomTours(bool quick);
+
+// Table 3's scenes along other camera paths and noise seeds (all three scenes per tour).
+struct OtherTour
+{
+  std::string name;
+  MethodStats ours, ransac, organized;
+};
+struct OtherToursExperiment
+{
+  bool with_pcl = false;
+  std::vector<OtherTour> tours;
+  std::map<std::string, int> causes;
+};
+OtherToursExperiment runOtherTours(bool quick);
+
+// Table 3's tours, ours only: block regions, the paper's windows and the paper's thinning.
+struct StageRow
+{
+  std::string scene;
+  MethodStats regions, windows, thinning;
+};
+std::vector<StageRow> runStageAndForgettingTours(bool quick);
+
+// Procedural rooms: every variant on the tuning and the held-out seeds.
+struct HeldOutRoom
+{
+  uint32_t seed = 0;
+  std::string room;
+  MethodStats defaults, windows;
+};
+struct RandomSceneExperiment
+{
+  int frames = 0;
+  std::vector<std::string> variants;           // the defaults first, the paper's windows last
+  std::vector<MethodStats> held_out, tuning;   // by variant
+  size_t held_out_seeds = 0, tuning_seeds = 0;
+  std::vector<HeldOutRoom> rooms;              // the held-out seeds one by one
+};
+RandomSceneExperiment runRandomScenes(bool quick);
+
+// ../shared/data/kinect-real: each frame alone; the planes found and a segmented picture.
+struct RealFrame
+{
+  std::string file;
+  std::vector<DetectedPlane> planes;
+  std::string picture;  // its file name in the pictures folder; empty when it could not be written
+};
+struct RealFramesExperiment
+{
+  std::vector<RealFrame> frames;
+  std::vector<double> ours_ms, ransac_ms, organized_ms;
+  size_t ransac_planes = 0, organized_planes = 0;  // in the last frame
+};
+bool runRealFrames(const std::vector<std::string>& paths, const std::string& pictures_dir,
+                   RealFramesExperiment& result, std::string* error);
+
+}  // namespace hough_plane_detector
