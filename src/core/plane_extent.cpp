@@ -1,6 +1,7 @@
 #include "hough_plane_detector/core/plane_extent.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <climits>
@@ -158,15 +159,26 @@ std::vector<PlaneOutline> PlaneExtent::outlines(int64_t frame, float fade) const
   return out;
 }
 
-std::vector<PlaneOutline> PlaneExtent::outlinesOf(const std::vector<std::pair<int32_t, int32_t>>& region) const
+namespace
 {
-  if (!basis_ || region.empty()) return {};
-  // Shapes are traced on a 10 cm grid (2 x 2 cells), closed (dilate, then erode, 3 x 3): far
-  // blocks mark cells a few centimetres apart, which the regions bridge and the shape must not
-  // show as a lattice of holes; holes and concave corners of 10 cm and more remain.
-  constexpr int32_t kCoarse = 2;
-  constexpr double kShapeCell = kCoarse * kCellSize;
-  auto coarse = [](int32_t v) { return v >= 0 ? v / kCoarse : -((-v + kCoarse - 1) / kCoarse); };
+// A region's cells on a coarser grid (kShapeCoarse x kShapeCoarse cells), closed (dilate, then
+// erode, 3 x 3): far blocks mark cells a few centimetres apart, which the regions bridge and the
+// shape must not show as a lattice of holes; holes and concave corners of 10 cm and more remain.
+constexpr int32_t kShapeCoarse = 2;
+constexpr double kShapeCell = kShapeCoarse * PlaneExtent::kCellSize;
+
+struct ShapeGrid
+{
+  int32_t x0 = 0, y0 = 0, w = 0, h = 0;  // coarse cell (x0, y0) at index 0; w x h cells
+  std::vector<uint8_t> closed;
+  size_t at(int32_t x, int32_t y) const { return static_cast<size_t>(y) * w + x; }
+  bool in(int32_t x, int32_t y) const { return x >= 0 && y >= 0 && x < w && y < h && closed[at(x, y)]; }
+  Eigen::Vector2d corner(int32_t x, int32_t y) const { return Eigen::Vector2d((x + x0) * kShapeCell, (y + y0) * kShapeCell); }
+};
+
+ShapeGrid closedShapeGrid(const std::vector<std::pair<int32_t, int32_t>>& region)
+{
+  auto coarse = [](int32_t v) { return v >= 0 ? v / kShapeCoarse : -((-v + kShapeCoarse - 1) / kShapeCoarse); };
   int32_t x_min = INT32_MAX, y_min = INT32_MAX, x_max = INT32_MIN, y_max = INT32_MIN;
   for (const auto& c : region)
   {
@@ -174,47 +186,76 @@ std::vector<PlaneOutline> PlaneExtent::outlinesOf(const std::vector<std::pair<in
     y_min = std::min(y_min, coarse(c.second)), y_max = std::max(y_max, coarse(c.second));
   }
   // A dense grid over the region with a margin of 2: dilation reaches 1 beyond, the boundary 1 more.
-  const int32_t x0 = x_min - 2, y0 = y_min - 2, w = x_max - x_min + 5, h = y_max - y_min + 5;
-  std::vector<uint8_t> marked(static_cast<size_t>(w) * h, 0), dilated(marked.size(), 0), closed(marked.size(), 0);
-  auto at = [w](int32_t x, int32_t y) { return static_cast<size_t>(y) * w + x; };
-  for (const auto& c : region) marked[at(coarse(c.first) - x0, coarse(c.second) - y0)] = 1;
+  ShapeGrid grid;
+  grid.x0 = x_min - 2, grid.y0 = y_min - 2, grid.w = x_max - x_min + 5, grid.h = y_max - y_min + 5;
+  const int32_t w = grid.w, h = grid.h;
+  std::vector<uint8_t> marked(static_cast<size_t>(w) * h, 0), dilated(marked.size(), 0);
+  grid.closed.assign(marked.size(), 0);
+  for (const auto& c : region) marked[grid.at(coarse(c.first) - grid.x0, coarse(c.second) - grid.y0)] = 1;
   for (int32_t y = 1; y + 1 < h; ++y)
     for (int32_t x = 1; x + 1 < w; ++x)
-      if (marked[at(x, y)])
+      if (marked[grid.at(x, y)])
         for (int32_t dy = -1; dy <= 1; ++dy)
-          for (int32_t dx = -1; dx <= 1; ++dx) dilated[at(x + dx, y + dy)] = 1;
+          for (int32_t dx = -1; dx <= 1; ++dx) dilated[grid.at(x + dx, y + dy)] = 1;
   for (int32_t y = 1; y + 1 < h; ++y)
     for (int32_t x = 1; x + 1 < w; ++x)
     {
       bool inside = true;
       for (int32_t dy = -1; dy <= 1 && inside; ++dy)
-        for (int32_t dx = -1; dx <= 1 && inside; ++dx) inside = dilated[at(x + dx, y + dy)] != 0;
-      closed[at(x, y)] = inside || marked[at(x, y)];
+        for (int32_t dx = -1; dx <= 1 && inside; ++dx) inside = dilated[grid.at(x + dx, y + dy)] != 0;
+      grid.closed[grid.at(x, y)] = inside || marked[grid.at(x, y)];
     }
+  return grid;
+}
+
+double signedArea(const std::vector<Eigen::Vector2d>& polygon)
+{
+  double area = 0.0;
+  for (size_t i = 0; i < polygon.size(); ++i)
+  {
+    const Eigen::Vector2d& p = polygon[i];
+    const Eigen::Vector2d& q = polygon[(i + 1) % polygon.size()];
+    area += 0.5 * (p.x() * q.y() - q.x() * p.y());
+  }
+  return area;
+}
+
+// Even-odd test.
+bool polygonContains(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& q)
+{
+  bool inside = false;
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
+    if ((polygon[i].y() > q.y()) != (polygon[j].y() > q.y()) &&
+        q.x() < (polygon[j].x() - polygon[i].x()) * (q.y() - polygon[i].y()) / (polygon[j].y() - polygon[i].y()) + polygon[i].x())
+      inside = !inside;
+  return inside;
+}
+
+// The closed grid's boundary loops (corners only): outer boundaries counter-clockwise (positive
+// area), holes clockwise.
+void traceBoundaries(const ShapeGrid& grid, std::vector<std::vector<Eigen::Vector2d>>& outers,
+                     std::vector<std::vector<Eigen::Vector2d>>& holes)
+{
   // Boundary edges with the region on their left (counter-clockwise around each cell), at most
-  // two leaving any grid vertex; chained into loops: outer boundaries turn counter-clockwise,
-  // holes clockwise.
-  const int32_t vw = w + 1;
-  std::vector<std::array<int32_t, 2>> out_edges(static_cast<size_t>(vw) * (h + 1), {-1, -1});
+  // two leaving any grid vertex.
+  const int32_t vw = grid.w + 1;
+  std::vector<std::array<int32_t, 2>> out_edges(static_cast<size_t>(vw) * (grid.h + 1), {-1, -1});
   size_t edge_count = 0;
   auto addEdge = [&](int32_t fx, int32_t fy, int32_t tx, int32_t ty) {
     auto& slots = out_edges[static_cast<size_t>(fy) * vw + fx];
     slots[slots[0] < 0 ? 0 : 1] = ty * vw + tx;
     ++edge_count;
   };
-  auto in = [&](int32_t x, int32_t y) { return x >= 0 && y >= 0 && x < w && y < h && closed[at(x, y)]; };
-  for (int32_t y = 0; y < h; ++y)
-    for (int32_t x = 0; x < w; ++x)
+  for (int32_t y = 0; y < grid.h; ++y)
+    for (int32_t x = 0; x < grid.w; ++x)
     {
-      if (!closed[at(x, y)]) continue;
-      if (!in(x, y - 1)) addEdge(x, y, x + 1, y);
-      if (!in(x + 1, y)) addEdge(x + 1, y, x + 1, y + 1);
-      if (!in(x, y + 1)) addEdge(x + 1, y + 1, x, y + 1);
-      if (!in(x - 1, y)) addEdge(x, y + 1, x, y);
+      if (!grid.closed[grid.at(x, y)]) continue;
+      if (!grid.in(x, y - 1)) addEdge(x, y, x + 1, y);
+      if (!grid.in(x + 1, y)) addEdge(x + 1, y, x + 1, y + 1);
+      if (!grid.in(x, y + 1)) addEdge(x + 1, y + 1, x, y + 1);
+      if (!grid.in(x - 1, y)) addEdge(x, y + 1, x, y);
     }
-  std::vector<std::vector<Eigen::Vector2d>> outers, holes;
-  std::vector<double> outer_areas;
-  auto point = [&](int32_t v) { return Eigen::Vector2d((v % vw + x0) * kShapeCell, (v / vw + y0) * kShapeCell); };
+  auto point = [&](int32_t v) { return grid.corner(v % vw, v / vw); };
   for (size_t start = 0; start < out_edges.size() && edge_count > 0; ++start)
     while (out_edges[start][0] >= 0)
     {
@@ -250,30 +291,17 @@ std::vector<PlaneOutline> PlaneExtent::outlinesOf(const std::vector<std::pair<in
         polygon.push_back(c);
       }
       if (polygon.size() < 3) continue;
-      double area = 0.0;
-      for (size_t i = 0; i < polygon.size(); ++i)
-      {
-        const Eigen::Vector2d& p = polygon[i];
-        const Eigen::Vector2d& q = polygon[(i + 1) % polygon.size()];
-        area += 0.5 * (p.x() * q.y() - q.x() * p.y());
-      }
-      if (area > 0.0)
-      {
-        outers.push_back(polygon);
-        outer_areas.push_back(area);
-      }
-      else
-        holes.push_back(polygon);
+      (signedArea(polygon) > 0.0 ? outers : holes).push_back(polygon);
     }
-  // Each hole belongs to the outer boundary around it (even-odd test of a point inside it).
-  auto contains = [](const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& q) {
-    bool inside = false;
-    for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++)
-      if ((polygon[i].y() > q.y()) != (polygon[j].y() > q.y()) &&
-          q.x() < (polygon[j].x() - polygon[i].x()) * (q.y() - polygon[i].y()) / (polygon[j].y() - polygon[i].y()) + polygon[i].x())
-        inside = !inside;
-    return inside;
-  };
+}
+}  // namespace
+
+std::vector<PlaneOutline> PlaneExtent::outlinesOf(const std::vector<std::pair<int32_t, int32_t>>& region) const
+{
+  if (!basis_ || region.empty()) return {};
+  const ShapeGrid grid = closedShapeGrid(region);
+  std::vector<std::vector<Eigen::Vector2d>> outers, holes;
+  traceBoundaries(grid, outers, holes);
   auto lift = [this](const std::vector<Eigen::Vector2d>& polygon) {
     std::vector<Eigen::Vector3d> lifted;
     for (const Eigen::Vector2d& q : polygon) lifted.push_back(basis_->lift(q));
@@ -283,42 +311,38 @@ std::vector<PlaneOutline> PlaneExtent::outlinesOf(const std::vector<std::pair<in
   for (size_t o = 0; o < outers.size(); ++o)
   {
     shapes[o].boundary = lift(outers[o]);
-    shapes[o].area = outer_areas[o];
+    shapes[o].area = signedArea(outers[o]);
   }
+  // Each hole belongs to the outer boundary around a point just right of its first edge (inside
+  // the hole, which is on the right of a clockwise loop); its (negative) area is taken off.
   for (const auto& hole : holes)
   {
-    double area = 0.0;  // negative: clockwise
-    for (size_t i = 0; i < hole.size(); ++i)
-      area += 0.5 * (hole[i].x() * hole[(i + 1) % hole.size()].y() - hole[(i + 1) % hole.size()].x() * hole[i].y());
-    // Just right of the hole's first edge, inside the hole (which is on the right of a clockwise loop).
     const Eigen::Vector2d edge = hole[1] - hole[0];
     const Eigen::Vector2d q = 0.5 * (hole[0] + hole[1]) + 0.25 * kShapeCell * Eigen::Vector2d(edge.y(), -edge.x()).normalized();
     for (size_t o = 0; o < outers.size(); ++o)
-      if (contains(outers[o], q))
+      if (polygonContains(outers[o], q))
       {
         shapes[o].holes.push_back(lift(hole));
-        shapes[o].area += area;
+        shapes[o].area += signedArea(hole);
         break;
       }
   }
   // Rows of the closed grid as rectangles, each given to the outer boundary around it.
-  for (int32_t y = 0; y < h; ++y)
-    for (int32_t x = 0; x < w;)
+  for (int32_t y = 0; y < grid.h; ++y)
+    for (int32_t x = 0; x < grid.w;)
     {
-      if (!closed[at(x, y)])
+      if (!grid.closed[grid.at(x, y)])
       {
         ++x;
         continue;
       }
       int32_t end = x;
-      while (end + 1 < w && closed[at(end + 1, y)]) ++end;
-      const double ax = (x + x0) * kShapeCell, bx = (end + 1 + x0) * kShapeCell;
-      const double ay = (y + y0) * kShapeCell, by = (y + 1 + y0) * kShapeCell;
-      const Eigen::Vector2d centre(0.5 * (ax + bx), 0.5 * (ay + by));
+      while (end + 1 < grid.w && grid.closed[grid.at(end + 1, y)]) ++end;
+      const Eigen::Vector2d a = grid.corner(x, y), b = grid.corner(end + 1, y + 1);
       for (size_t o = 0; o < outers.size(); ++o)
-        if (contains(outers[o], centre))
+        if (polygonContains(outers[o], 0.5 * (a + b)))
         {
-          shapes[o].fill.push_back({basis_->lift({ax, ay}), basis_->lift({bx, ay}), basis_->lift({bx, by}), basis_->lift({ax, by})});
+          shapes[o].fill.push_back({basis_->lift(a), basis_->lift({b.x(), a.y()}), basis_->lift(b), basis_->lift({a.x(), b.y()})});
           break;
         }
       x = end + 1;
