@@ -1,5 +1,5 @@
 // The osd-learn section of make evaluate on its own, for quick checks while changing the
-// detector: evaluate_osd DIR [--no-pcl] [--misses] [--pictures OUT_DIR] [--param-name VALUE ...]
+// detector: evaluate_osd DIR [--no-pcl] [--misses] [--pictures OUT_DIR] [--PARAM VALUE ...]
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -11,41 +11,34 @@ using namespace hough_plane_detector;
 
 int main(int argc, char** argv)
 {
-  if (argc < 2)
+  namespace po = boost::program_options;
+  std::string dir, picture_dir;
+  DetectorParams params;
+  po::options_description options("options"), detector_options("detector parameters"), hidden;
+  options.add_options()("help,h", "this help")
+      ("no-pcl", "skip PCL RANSAC and OMPS")
+      ("misses", "list every missed entry with what became of its candidate")
+      ("pictures", po::value(&picture_dir)->value_name("OUT_DIR"), "write segmented pictures of a few frames there");
+  addDetectorParamOptions(params, detector_options, hidden);
+  hidden.add_options()("dir", po::value(&dir));
+  po::positional_options_description positional;
+  positional.add("dir", 1);
+  po::options_description all;
+  all.add(options).add(detector_options).add(hidden);
+  po::variables_map values;
+  std::string parse_error;
+  if (!parseCommandLine(argc, argv, all, positional, values, &parse_error) || (dir.empty() && !values.count("help")))
   {
-    std::cerr << "usage: evaluate_osd DIR [--no-pcl] [--misses] [--pictures OUT_DIR] [--PARAM VALUE ...]\n";
+    std::cerr << "evaluate_osd: " << (parse_error.empty() ? "no osd-learn folder given" : parse_error) << "\n"
+              << "usage: evaluate_osd DIR [options] (see --help)\n";
     return 2;
   }
-  const std::string dir = argv[1];
-  DetectorParams params;
-  bool with_pcl = true, misses = false;
-  std::string picture_dir;
-  for (int i = 2; i < argc; ++i)
+  if (values.count("help"))
   {
-    std::string arg = argv[i];
-    if (arg == "--no-pcl")
-      with_pcl = false;
-    else if (arg == "--misses")
-      misses = true;
-    else if (arg == "--pictures" && i + 1 < argc)
-      picture_dir = argv[++i];
-    else if (arg.rfind("--", 0) == 0 && i + 1 < argc)
-    {
-      std::string name = arg.substr(2), error;
-      for (char& c : name)
-        if (c == '-') c = '_';
-      if (!setDetectorParam(params, name, argv[++i], &error))
-      {
-        std::cerr << "evaluate_osd: " << error << "\n";
-        return 2;
-      }
-    }
-    else
-    {
-      std::cerr << "evaluate_osd: unexpected argument " << arg << "\n";
-      return 2;
-    }
+    std::cout << "usage: evaluate_osd DIR [options]\n" << options << detector_options;
+    return 0;
   }
+  const bool with_pcl = !values.count("no-pcl"), misses = values.count("misses") > 0;
   OsdResults results;
   std::string error;
   if (!evaluateOsdLearn(dir, params, with_pcl, picture_dir, results, &error))

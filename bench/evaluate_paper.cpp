@@ -8,12 +8,14 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <limits>
 #include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "hough_plane_detector/tools/cli_options.h"
 #include "osd_learn.h"
 #include "paper_experiments.h"
 #include "pcl_comparators.h"
@@ -444,24 +446,26 @@ void writeOsdLearn(const OsdResults& results, Report& report)
 
 int main(int argc, char** argv)
 {
+  namespace po = boost::program_options;
   Report report;
   std::vector<std::string> pcds;
   std::string osd_dir;
-  for (int i = 1; i < argc; ++i)
+  po::options_description options("options"), hidden;
+  options.add_options()("help,h", "this help")("quick", po::bool_switch(&report.quick), "short sequences, for routine checks")
+      ("osd", po::value(&osd_dir)->value_name("OSD_LEARN_DIR"), "add the annotated real frames of osd-learn");
+  hidden.add_options()("out-dir", po::value(&report.out_dir))("pcd", po::value(&pcds));
+  po::positional_options_description positional;
+  positional.add("out-dir", 1).add("pcd", -1);
+  po::options_description all;
+  all.add(options).add(hidden);
+  po::variables_map values;
+  std::string error;
+  const bool parsed = parseCommandLine(argc, argv, all, positional, values, &error);
+  if (!parsed || values.count("help") || report.out_dir.empty())
   {
-    if (std::strcmp(argv[i], "--quick") == 0)
-      report.quick = true;
-    else if (std::strcmp(argv[i], "--osd") == 0 && i + 1 < argc)
-      osd_dir = argv[++i];
-    else if (report.out_dir.empty())
-      report.out_dir = argv[i];
-    else
-      pcds.push_back(argv[i]);
-  }
-  if (report.out_dir.empty())
-  {
-    std::fprintf(stderr, "usage: evaluate_paper OUT_DIR [--quick] [--osd OSD_LEARN_DIR] [FRAME.pcd ...]\n");
-    return 2;
+    if (!parsed) std::fprintf(stderr, "evaluate_paper: %s\n", error.c_str());
+    std::cerr << "usage: evaluate_paper OUT_DIR [options] [FRAME.pcd ...]\n" << options;
+    return values.count("help") && parsed ? 0 : 2;
   }
   const auto start = Clock::now();
   std::fprintf(stderr, "Fig. 6 and 7: noise levels\n");

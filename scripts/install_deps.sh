@@ -9,7 +9,7 @@ packages=(
   python3-rostest python3-rosbag python3-catkin-pkg
   libnodelet-dev libnodeletlib-dev libnodeletlib-tools libtf2-ros-dev libtf2-eigen-dev libtf2-sensor-msgs-dev
   libvisualization-msgs-dev libstd-srvs-dev libshape-msgs-dev libpcl-msgs-dev ros-pcl-msgs libdepth-image-proc-dev libdynamic-reconfigure-config-init-mutex-dev
-  python3-dynamic-reconfigure libdiagnostic-updater-dev libmessage-filters-dev libpcl-conversions-dev libpng-dev nlohmann-json3-dev libopenni2-dev libfreenect-dev clang libclang-rt-14-dev
+  python3-dynamic-reconfigure libdiagnostic-updater-dev libmessage-filters-dev libpcl-conversions-dev libpng-dev libboost-program-options-dev nlohmann-json3-dev libopenni2-dev libfreenect-dev clang libclang-rt-14-dev
   ros-std-srvs ros-shape-msgs ros-visualization-msgs ros-diagnostic-msgs ros-message-runtime
   python3-roslaunch python3-rosmaster python3-rospy rosout tf2-tools rosbash
   # What a ROS user reaches for first: rostopic echo/hz, rosservice call, rosnode, rosparam, and

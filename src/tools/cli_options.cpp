@@ -94,20 +94,46 @@ bool setDetectorParam(DetectorParams& params, const std::string& name, const std
   return false;
 }
 
-std::vector<std::string> detectorParamHelp()
+void addDetectorParamOptions(DetectorParams& params, boost::program_options::options_description& visible,
+                             boost::program_options::options_description& hidden)
 {
+  namespace po = boost::program_options;
   const DetectorParams defaults;
-  std::vector<std::string> lines;
   for (const ParamEntry& entry : paramTable())
   {
-    std::ostringstream line;
-    line << "--" << entry.name << " ("
-         << (entry.int_member ? "int, default " + std::to_string(defaults.*entry.int_member)
-                              : "double, default " + number(defaults.*entry.double_member))
-         << ")";
-    lines.push_back(line.str());
+    const std::string name = entry.name;
+    const std::string help = entry.int_member ? "int, default " + std::to_string(defaults.*entry.int_member)
+                                              : "double, default " + number(defaults.*entry.double_member);
+    auto apply = [&params, name](const std::string& value) {
+      std::string error;
+      if (!setDetectorParam(params, name, value, &error)) throw po::error(error);
+    };
+    visible.add_options()(name.c_str(), po::value<std::string>()->value_name("VALUE")->notifier(apply), help.c_str());
+    std::string dashed = name;
+    for (char& c : dashed)
+      if (c == '_') c = '-';
+    if (dashed != name) hidden.add_options()(dashed.c_str(), po::value<std::string>()->notifier(apply), "");
   }
-  return lines;
+}
+
+bool parseCommandLine(int argc, char** argv, const boost::program_options::options_description& options,
+                      const boost::program_options::positional_options_description& positional,
+                      boost::program_options::variables_map& values, std::string* error)
+{
+  namespace po = boost::program_options;
+  try
+  {
+    // Whole option names only: a prefix that happens to match one parameter is a typo, not a choice.
+    const int style = po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
+    po::store(po::command_line_parser(argc, argv).options(options).positional(positional).style(style).run(), values);
+    po::notify(values);
+  }
+  catch (const po::error& e)
+  {
+    if (error) *error = e.what();
+    return false;
+  }
+  return true;
 }
 
 namespace

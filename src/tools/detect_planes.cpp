@@ -10,70 +10,46 @@
 #include "hough_plane_detector/tools/input_sources.h"
 
 using namespace hough_plane_detector;
-
-namespace
-{
-void usage(std::ostream& out)
-{
-  out << "usage: detect_planes --bag FILE --topic TOPIC [--world-frame odom] [options]\n"
-         "       detect_planes FILE.pcd [FILE.pcd ...] [options]\n"
-         "options:\n"
-         "  --out FILE            write the JSON lines to FILE instead of stdout\n"
-         "  --world-frame FRAME   frame the planes are reported in (bag input; default odom)\n"
-         "  --camera-info TOPIC   camera_info of a depth-image topic (sensor_msgs/Image, 16UC1 mm or 32FC1 m;\n"
-         "                        default: the camera_info beside the image topic)\n";
-  for (const std::string& line : detectorParamHelp()) out << "  " << line << "\n";
-}
-}  // namespace
+namespace po = boost::program_options;
 
 int main(int argc, char** argv)
 {
-  std::string bag_path, topic, world_frame = "odom", out_path, camera_info_topic;
+  std::string bag_path, topic, world_frame, out_path, camera_info_topic;
   std::vector<std::string> pcd_paths;
   DetectorParams params;
-  for (int i = 1; i < argc; ++i)
+  po::options_description tool("options"), detector_options("detector parameters (dashes for underscores work too)"),
+      hidden;
+  tool.add_options()("help,h", "this help")
+      ("bag", po::value(&bag_path)->value_name("FILE"), "rosbag to read clouds or depth images from")
+      ("topic", po::value(&topic)->value_name("TOPIC"), "sensor_msgs/PointCloud2 or sensor_msgs/Image topic of --bag")
+      ("world-frame", po::value(&world_frame)->value_name("FRAME")->default_value("odom"),
+       "frame the planes are reported in (bag input)")
+      ("camera-info", po::value(&camera_info_topic)->value_name("TOPIC"),
+       "camera_info of a depth-image topic (16UC1 mm or 32FC1 m; default: the camera_info beside the image topic)")
+      ("out", po::value(&out_path)->value_name("FILE"), "write the JSON lines to FILE instead of stdout");
+  addDetectorParamOptions(params, detector_options, hidden);
+  hidden.add_options()("pcd", po::value(&pcd_paths));
+  po::positional_options_description positional;
+  positional.add("pcd", -1);
+  po::options_description all;
+  all.add(tool).add(detector_options).add(hidden);
+  po::variables_map values;
+  std::string parse_error;
+  const char* usage = "usage: detect_planes --bag FILE --topic TOPIC [--world-frame odom] [options]\n"
+                      "       detect_planes FILE.pcd [FILE.pcd ...] [options]\n";
+  if (!parseCommandLine(argc, argv, all, positional, values, &parse_error))
   {
-    const std::string arg = argv[i];
-    if (arg == "-h" || arg == "--help")
-    {
-      usage(std::cout);
-      return 0;
-    }
-    if (arg.rfind("--", 0) == 0)
-    {
-      if (i + 1 >= argc)
-      {
-        std::cerr << "detect_planes: " << arg << " needs a value\n";
-        return 2;
-      }
-      const std::string value = argv[++i];
-      if (arg == "--bag") bag_path = value;
-      else if (arg == "--topic") topic = value;
-      else if (arg == "--world-frame") world_frame = value;
-      else if (arg == "--camera-info") camera_info_topic = value;
-      else if (arg == "--out") out_path = value;
-      else
-      {
-        std::string error;
-        std::string name = arg.substr(2);
-        for (char& c : name)
-          if (c == '-') c = '_';
-        if (!setDetectorParam(params, name, value, &error))
-        {
-          std::cerr << "detect_planes: " << error << " (see --help)\n";
-          return 2;
-        }
-      }
-    }
-    else
-    {
-      pcd_paths.push_back(arg);
-    }
+    std::cerr << "detect_planes: " << parse_error << " (see --help)\n";
+    return 2;
+  }
+  if (values.count("help"))
+  {
+    std::cout << usage << tool << detector_options;
+    return 0;
   }
   if (bag_path.empty() == pcd_paths.empty())
   {
-    std::cerr << "detect_planes: give either --bag FILE --topic TOPIC or PCD files\n";
-    usage(std::cerr);
+    std::cerr << "detect_planes: give either --bag FILE --topic TOPIC or PCD files\n" << usage;
     return 2;
   }
   if (!bag_path.empty() && topic.empty())

@@ -2,6 +2,7 @@
 // printed next to the true ones with the accuracy metrics and ms per frame.
 #include <algorithm>
 #include <cstdio>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -14,42 +15,36 @@ using namespace hough_plane_detector;
 
 int main(int argc, char** argv)
 {
+  namespace po = boost::program_options;
   int frames = 40;
   double noise = 1.0;
   std::string scene_name = "office";
   DetectorParams params;
-  for (int i = 1; i < argc; i += 2)
+  po::options_description demo("options"), detector_options("detector parameters"), hidden;
+  demo.add_options()("help,h", "this help")
+      ("frames", po::value(&frames)->value_name("N")->default_value(40)->notifier([](int n) {
+        if (n < 1) throw po::error("--frames needs a positive integer, got " + std::to_string(n));
+      }), "frames of the tour")
+      ("noise", po::value(&noise)->value_name("C")->default_value(1.0)->notifier([](double c) {
+        if (!(c >= 0.0)) throw po::error("--noise needs a number >= 0");
+      }), "noise coefficient C of eq. 11")
+      ("scene", po::value(&scene_name)->value_name("NAME")->default_value("office")->notifier([](const std::string& name) {
+        if (name != "office" && name != "hall") throw po::error("--scene needs office or hall, got '" + name + "'");
+      }), "office or hall");
+  addDetectorParamOptions(params, detector_options, hidden);
+  po::options_description all;
+  all.add(demo).add(detector_options).add(hidden);
+  po::variables_map values;
+  std::string error;
+  if (!parseCommandLine(argc, argv, all, po::positional_options_description(), values, &error))
   {
-    const std::string flag = argv[i];
-    if (flag.rfind("--", 0) != 0 || i + 1 >= argc)
-    {
-      std::fprintf(stderr, "hough_demo: expected --NAME VALUE pairs, got '%s'\n", flag.c_str());
-      return 2;
-    }
-    const std::string name = flag.substr(2), value = argv[i + 1];
-    std::string error;
-    if (name == "frames")
-    {
-      if (!parseInteger(value, &frames) || frames < 1) error = "--frames needs a positive integer, got '" + value + "'";
-    }
-    else if (name == "noise")
-    {
-      if (!parseFinite(value, &noise) || noise < 0.0) error = "--noise needs a number >= 0, got '" + value + "'";
-    }
-    else if (name == "scene")
-    {
-      scene_name = value;
-      if (value != "office" && value != "hall") error = "--scene needs office or hall, got '" + value + "'";
-    }
-    else
-    {
-      setDetectorParam(params, name, value, &error);  // sets `error` when it refuses
-    }
-    if (!error.empty())
-    {
-      std::fprintf(stderr, "hough_demo: %s\n", error.c_str());
-      return 2;
-    }
+    std::fprintf(stderr, "hough_demo: %s\n", error.c_str());
+    return 2;
+  }
+  if (values.count("help"))
+  {
+    std::cout << "usage: hough_demo [options]\n" << demo << detector_options;
+    return 0;
   }
   std::string invalid;
   if (!params.validate(&invalid))

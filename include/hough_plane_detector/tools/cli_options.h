@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <boost/program_options.hpp>
+
 #include "hough_plane_detector/core/plane_detector.h"
 
 namespace hough_plane_detector
@@ -16,8 +18,17 @@ bool parseFinite(const std::string& text, double* out);
 
 // Sets the parameter `name` from text; false with `error` set for an unknown name or bad value.
 bool setDetectorParam(DetectorParams& params, const std::string& name, const std::string& value, std::string* error);
-// "name (type, default)" lines for --help.
-std::vector<std::string> detectorParamHelp();
+// Adds --NAME VALUE for every detector parameter to `visible` (the names dynamic_reconfigure
+// uses) and, spelt with dashes, to `hidden`; each value is set in `params` through
+// setDetectorParam when the options are notified, a bad one throwing
+// boost::program_options::error with setDetectorParam's message. `params` must outlive the parse.
+void addDetectorParamOptions(DetectorParams& params, boost::program_options::options_description& visible,
+                             boost::program_options::options_description& hidden);
+// boost::program_options' parse, store and notify of argv: false with `error` set (the
+// library's message, or a parameter's) on anything it refuses.
+bool parseCommandLine(int argc, char** argv, const boost::program_options::options_description& options,
+                      const boost::program_options::positional_options_description& positional,
+                      boost::program_options::variables_map& values, std::string* error);
 
 // {"frame": 0, "stamp": 12.34, "frame_id": "odom", "ms": 4.2, "planes": [...]}; `outlines`,
 // when given, holds each plane's region shapes (PlaneDetector::outlines), in the planes' order.
