@@ -46,12 +46,9 @@ float readField(const uint8_t* p, uint8_t datatype)
   }
   return 0.0f;
 }
-}  // namespace
 
-namespace
-{
-// What is wrong with the buffer (empty: nothing), making the view on the way.
-std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vector<float>& converted)
+// What is wrong with the layout (empty: nothing); its x, y and z fields in `xyz`.
+std::string layoutProblem(const PointBufferLayout& layout, const PointFieldLayout* xyz[3])
 {
   std::ostringstream err;
   if (layout.width == 0 || layout.height == 0)
@@ -60,12 +57,9 @@ std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vec
     return err.str();
   }
   if (layout.is_bigendian) return "cloud is big-endian; only little-endian clouds are supported";
-  const PointFieldLayout* xyz[3] = {nullptr, nullptr, nullptr};
   for (const auto& field : layout.fields)
-  {
     for (int axis = 0; axis < 3; ++axis)
       if (field.name == std::string(1, "xyz"[axis])) xyz[axis] = &field;
-  }
   std::string missing;
   for (int axis = 0; axis < 3; ++axis)
     if (!xyz[axis]) missing += std::string(missing.empty() ? "" : ", ") + "xyz"[axis];
@@ -76,7 +70,6 @@ std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vec
     err << ")";
     return err.str();
   }
-  bool all_float32 = true;
   for (int axis = 0; axis < 3; ++axis)
   {
     const size_t size = datatypeSize(xyz[axis]->datatype);
@@ -91,7 +84,6 @@ std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vec
           << " bytes) does not fit in point_step " << layout.point_step;
       return err.str();
     }
-    all_float32 = all_float32 && xyz[axis]->datatype == static_cast<uint8_t>(PointDatatype::kFloat32);
   }
   if (static_cast<uint64_t>(layout.point_step) * layout.width > layout.row_step)
   {
@@ -105,8 +97,19 @@ std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vec
         << layout.height << " needs " << static_cast<uint64_t>(layout.row_step) * layout.height;
     return err.str();
   }
+  return std::string();
+}
+
+// A view of a checked layout: float32 x/y/z in place, other datatypes (float64 from some
+// drivers, integers in mm) converted once into `converted`.
+void viewFields(const PointBufferLayout& layout, const PointFieldLayout* const xyz[3], CloudView& view,
+                std::vector<float>& converted)
+{
   view.width = static_cast<int>(layout.width);
   view.height = static_cast<int>(layout.height);
+  bool all_float32 = true;
+  for (int axis = 0; axis < 3; ++axis)
+    all_float32 = all_float32 && xyz[axis]->datatype == static_cast<uint8_t>(PointDatatype::kFloat32);
   if (all_float32)
   {
     view.data = layout.data;
@@ -115,9 +118,8 @@ std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vec
     view.x_offset = xyz[0]->offset;
     view.y_offset = xyz[1]->offset;
     view.z_offset = xyz[2]->offset;
-    return "";
+    return;
   }
-  // Other datatypes (float64 from some drivers, integers in mm) are converted once.
   converted.resize(static_cast<size_t>(layout.width) * layout.height * 3);
   for (uint32_t v = 0; v < layout.height; ++v)
     for (uint32_t u = 0; u < layout.width; ++u)
@@ -132,16 +134,20 @@ std::string viewCloud(const PointBufferLayout& layout, CloudView& view, std::vec
   view.x_offset = 0;
   view.y_offset = 4;
   view.z_offset = 8;
-  return "";
 }
 }  // namespace
 
 bool makeCloudView(const PointBufferLayout& layout, CloudView& view, std::vector<float>& converted, std::string* error)
 {
-  const std::string problem = viewCloud(layout, view, converted);
-  if (problem.empty()) return true;
-  if (error) *error = problem;
-  return false;
+  const PointFieldLayout* xyz[3] = {nullptr, nullptr, nullptr};
+  const std::string problem = layoutProblem(layout, xyz);
+  if (!problem.empty())
+  {
+    if (error) *error = problem;
+    return false;
+  }
+  viewFields(layout, xyz, view, converted);
+  return true;
 }
 
 }  // namespace hough_plane_detector
