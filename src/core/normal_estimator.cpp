@@ -115,80 +115,92 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
     }
 }
 
+namespace
+{
+// Per block, float sums relative to the block's first valid point keep full precision (sums of
+// squares of metres in float would swamp millimetre noise); doubles after that.
+struct BlockAccumulator
+{
+  float rx, ry, rz;
+  float n;
+  float sx, sy, sz, xx, xy, xz, yy, yz, zz;
+};
+
+// Each block of row `by` starts empty with its first valid point as reference (found before the
+// main pass, so the per-point loop has no data-dependent branch).
+void startBlockRow(const CloudView& cloud, int by, int s, std::vector<BlockAccumulator>& row_blocks)
+{
+  for (size_t bx = 0; bx < row_blocks.size(); ++bx)
+  {
+    BlockAccumulator& b = row_blocks[bx];
+    b = BlockAccumulator{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    bool found = false;
+    for (int v = by * s; v < (by + 1) * s && !found; ++v)
+      for (int u = static_cast<int>(bx) * s; u < static_cast<int>(bx + 1) * s && !found; ++u)
+      {
+        float x, y, z;
+        cloud.point(u, v, x, y, z);
+        if (std::isfinite(x + y + z))
+        {
+          b.rx = x; b.ry = y; b.rz = z;
+          found = true;
+        }
+      }
+  }
+}
+
+// Adds pixel row v to the blocks it crosses.
+void accumulatePixelRow(const CloudView& cloud, int v, int s, std::vector<BlockAccumulator>& row_blocks)
+{
+  const uint8_t* row = cloud.data + static_cast<size_t>(v) * cloud.row_step;
+  for (size_t bx = 0; bx < row_blocks.size(); ++bx)
+  {
+    BlockAccumulator& b = row_blocks[bx];
+    const uint8_t* p = row + bx * s * cloud.point_step;
+    float n = 0, sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+    for (int i = 0; i < s; ++i, p += cloud.point_step)
+    {
+      float x, y, z;
+      std::memcpy(&x, p + cloud.x_offset, sizeof(float));
+      std::memcpy(&y, p + cloud.y_offset, sizeof(float));
+      std::memcpy(&z, p + cloud.z_offset, sizeof(float));
+      const bool valid = std::isfinite(x + y + z);  // NaN or Inf in any coordinate
+      const float qx = valid ? x - b.rx : 0.0f, qy = valid ? y - b.ry : 0.0f, qz = valid ? z - b.rz : 0.0f;
+      n += valid ? 1.0f : 0.0f;
+      sx += qx; sy += qy; sz += qz;
+      xx += qx * qx; xy += qx * qy; xz += qx * qz;
+      yy += qy * qy; yz += qy * qz; zz += qz * qz;
+    }
+    b.n += n;
+    b.sx += sx; b.sy += sy; b.sz += sz;
+    b.xx += xx; b.xy += xy; b.xz += xz; b.yy += yy; b.yz += yz; b.zz += zz;
+  }
+}
+
+// The block's moments about the origin: S = Q + r q^T + q r^T + n r r^T for relative sums Q, q.
+void toMoments(const BlockAccumulator& b, PointMoments& m)
+{
+  const double n = b.n, rx = b.rx, ry = b.ry, rz = b.rz;
+  m.count = n;
+  m.sum = Eigen::Vector3d(b.sx + n * rx, b.sy + n * ry, b.sz + n * rz);
+  m.xx = b.xx + 2.0 * rx * b.sx + n * rx * rx;
+  m.yy = b.yy + 2.0 * ry * b.sy + n * ry * ry;
+  m.zz = b.zz + 2.0 * rz * b.sz + n * rz * rz;
+  m.xy = b.xy + rx * b.sy + ry * b.sx + n * rx * ry;
+  m.xz = b.xz + rx * b.sz + rz * b.sx + n * rx * rz;
+  m.yz = b.yz + ry * b.sz + rz * b.sy + n * ry * rz;
+}
+}  // namespace
+
 void NormalEstimator::accumulateBlocks(const CloudView& cloud, int s)
 {
-  // Per block, float sums relative to the block's first valid point keep full precision
-  // (sums of squares of metres in float would swamp millimetre noise); doubles after that.
-  struct BlockAccumulator
-  {
-    float rx, ry, rz;
-    float n;
-    float sx, sy, sz, xx, xy, xz, yy, yz, zz;
-  };
   std::vector<BlockAccumulator> row_blocks(blocks_x_);
   for (int by = 0; by < blocks_y_; ++by)
   {
-    // Reference point of each block: its first valid point (found before the main pass, so
-    // the per-point loop below has no data-dependent branch).
+    startBlockRow(cloud, by, s, row_blocks);
+    for (int v = by * s; v < (by + 1) * s; ++v) accumulatePixelRow(cloud, v, s, row_blocks);
     for (int bx = 0; bx < blocks_x_; ++bx)
-    {
-      BlockAccumulator& b = row_blocks[bx];
-      b = BlockAccumulator{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
-      bool found = false;
-      for (int v = by * s; v < (by + 1) * s && !found; ++v)
-        for (int u = bx * s; u < (bx + 1) * s && !found; ++u)
-        {
-          float x, y, z;
-          cloud.point(u, v, x, y, z);
-          if (std::isfinite(x + y + z))
-          {
-            b.rx = x; b.ry = y; b.rz = z;
-            found = true;
-          }
-        }
-    }
-    for (int v = by * s; v < (by + 1) * s; ++v)
-    {
-      const uint8_t* row = cloud.data + static_cast<size_t>(v) * cloud.row_step;
-      for (int bx = 0; bx < blocks_x_; ++bx)
-      {
-        BlockAccumulator& b = row_blocks[bx];
-        const uint8_t* p = row + static_cast<size_t>(bx * s) * cloud.point_step;
-        float n = 0, sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-        for (int i = 0; i < s; ++i, p += cloud.point_step)
-        {
-          float x, y, z;
-          std::memcpy(&x, p + cloud.x_offset, sizeof(float));
-          std::memcpy(&y, p + cloud.y_offset, sizeof(float));
-          std::memcpy(&z, p + cloud.z_offset, sizeof(float));
-          const bool valid = std::isfinite(x + y + z);  // NaN or Inf in any coordinate
-          const float qx = valid ? x - b.rx : 0.0f, qy = valid ? y - b.ry : 0.0f, qz = valid ? z - b.rz : 0.0f;
-          n += valid ? 1.0f : 0.0f;
-          sx += qx; sy += qy; sz += qz;
-          xx += qx * qx; xy += qx * qy; xz += qx * qz;
-          yy += qy * qy; yz += qy * qz; zz += qz * qz;
-        }
-        b.n += n;
-        b.sx += sx; b.sy += sy; b.sz += sz;
-        b.xx += xx; b.xy += xy; b.xz += xz; b.yy += yy; b.yz += yz; b.zz += zz;
-      }
-    }
-    for (int bx = 0; bx < blocks_x_; ++bx)
-    {
-      const BlockAccumulator& b = row_blocks[bx];
-      PointMoments& m = blocks_[static_cast<size_t>(by) * blocks_x_ + bx];
-      if (b.n == 0.0f) continue;
-      // Shift the relative sums back to the origin: S = Q + r q^T + q r^T + n r r^T.
-      const double n = b.n, rx = b.rx, ry = b.ry, rz = b.rz;
-      m.count = n;
-      m.sum = Eigen::Vector3d(b.sx + n * rx, b.sy + n * ry, b.sz + n * rz);
-      m.xx = b.xx + 2.0 * rx * b.sx + n * rx * rx;
-      m.yy = b.yy + 2.0 * ry * b.sy + n * ry * ry;
-      m.zz = b.zz + 2.0 * rz * b.sz + n * rz * rz;
-      m.xy = b.xy + rx * b.sy + ry * b.sx + n * rx * ry;
-      m.xz = b.xz + rx * b.sz + rz * b.sx + n * rx * rz;
-      m.yz = b.yz + ry * b.sz + rz * b.sy + n * ry * rz;
-    }
+      if (row_blocks[bx].n > 0.0f) toMoments(row_blocks[bx], blocks_[static_cast<size_t>(by) * blocks_x_ + bx]);
   }
 }
 
