@@ -26,21 +26,12 @@ void printStats(const MethodStats& s, const char* name)
   std::printf("  %-34s %8.2f %8.2f %8.2f   %.4f   %.4f   %5.1f %%   %.2f\n", name, median(s.ms), percentile(s.ms, 0.1),
               percentile(s.ms, 0.9), mean(s.angle), mean(s.d), s.detectionPercent(), s.falsePerFrame());
 }
-}  // namespace
-
-int main(int argc, char** argv)
+// Ours on two laps of the tour (medians of a warmed-up map; accuracy from frame 3 of lap one):
+// the stages' times printed, the scores and the detector (for its memory) returned.
+MethodStats benchStages(const SceneRenderer& renderer, const std::vector<RenderedFrame>& rendered,
+                        PlaneDetector& detector)
 {
-  const int frames = 40;
-  std::printf("hough_plane_detector benchmark: one core, 640 x 480 frames, default parameters\n\n");
-  SceneRenderer renderer(makeOfficeRoom());
-  KinectNoise noise;
-  noise.coefficient = 1.0;
-  const auto poses = roomTour(frames);
-  std::vector<RenderedFrame> rendered;
-  for (int f = 0; f < frames; ++f) rendered.push_back(renderer.render(poses[f], noise, 500 + f));
-
-  // Ours: two laps so the medians are of a warmed-up map; accuracy from frame 3 of lap one.
-  PlaneDetector detector{DetectorParams()};
+  const int frames = static_cast<int>(rendered.size());
   constexpr int kStages = 9;
   std::vector<double> stage[kStages];
   MethodStats ours;
@@ -61,9 +52,15 @@ int main(int argc, char** argv)
   std::printf("rendered office tour, Kinect noise C = 1.0, %d frames x 2 laps; median ms per stage (p90):\n", frames);
   for (int i = 0; i < kStages; ++i)
     std::printf("  %-20s %6.3f ms (%.3f)\n", names[i], median(stage[i]), percentile(stage[i], 0.9));
-  // What the options cost on the same frames: the paper's windows instead of block regions,
-  // and the paper's thinning instead of forgetting by evidence (its check of the map's planes
-  // against each frame).
+  return ours;
+}
+
+// What the options cost on the same frames: the paper's windows instead of block regions, and
+// the paper's thinning instead of forgetting by evidence (its check of the map's planes against
+// each frame); and fitting the projection to each cloud.
+void benchVariants(const std::vector<RenderedFrame>& rendered)
+{
+  const int frames = static_cast<int>(rendered.size());
   auto variantMedians = [&](const DetectorParams& params, std::vector<double>* evidence_ms) {
     PlaneDetector variant(params);
     std::vector<double> total;
@@ -97,6 +94,66 @@ int main(int argc, char** argv)
     if (!k.valid()) std::printf("  no projection fitted to frame %d\n", f);
   }
   std::printf("  of the normals: the projection fitted to the cloud %.3f ms\n", median(intrinsics_ms));
+}
+
+// Real Kinect frames, a still camera: each file five times into one map; PCL's methods once.
+bool benchRealFrames(const std::vector<std::string>& paths)
+{
+  PlaneDetector real{DetectorParams()};
+  std::vector<double> ours_ms, ransac_ms, organized_ms;
+  size_t ours_planes = 0, ransac_planes = 0, organized_planes = 0;
+  for (int rep = 0; rep < 5; ++rep)
+    for (size_t i = 0; i < paths.size(); ++i)
+    {
+      pcl::PCLPointCloud2 blob;
+      std::string error;
+      CloudView view;
+      std::vector<float> converted;
+      if (!loadPcd(paths[i], blob, &error) || !makeCloudView(layoutOf(blob), view, converted, &error) ||
+          !real.processFrame(view, Eigen::Isometry3d::Identity(), rep * paths.size() + i, &error))
+      {
+        std::fprintf(stderr, "%s: %s\n", paths[i].c_str(), error.c_str());
+        return false;
+      }
+      ours_ms.push_back(real.lastTimings().total_ms);
+      ours_planes = real.planes().size();
+      if (rep > 0) continue;
+      auto cloud = toPclCloud(view);
+      auto t = Clock::now();
+      ransac_planes = pclRansacPlanes(cloud, 500, 0.02, 2000).size();
+      ransac_ms.push_back(msSince(t));
+      t = Clock::now();
+      organized_planes = pclOrganizedPlanes(cloud, 2000).size();
+      organized_ms.push_back(msSince(t));
+    }
+  std::printf("real Kinect frames (%zu PCD files, still camera): median ms per frame and planes found\n", paths.size());
+  std::printf("  %-34s %8.2f ms  %zu planes in the map\n", "hough_plane_detector", median(ours_ms), ours_planes);
+  std::printf("  %-34s %8.2f ms  %zu planes (last frame)\n", "PCL RANSAC (2 cm, 500 it, LSQ)", median(ransac_ms), ransac_planes);
+  std::printf("  %-34s %8.2f ms  %zu planes (last frame)\n", "PCL OrganizedMultiPlaneSegm.", median(organized_ms),
+              organized_planes);
+  std::printf("  speed-up: %.1fx vs PCL RANSAC, %.1fx vs PCL organized segmentation\n", median(ransac_ms) / median(ours_ms),
+              median(organized_ms) / median(ours_ms));
+  for (const auto& p : real.planes())
+    std::printf("    plane %d: n = (%+.3f %+.3f %+.3f), d = %+.3f, support %d\n", p.id, p.normal.x(), p.normal.y(),
+                p.normal.z(), p.d, p.support);
+  return true;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  const int frames = 40;
+  std::printf("hough_plane_detector benchmark: one core, 640 x 480 frames, default parameters\n\n");
+  SceneRenderer renderer(makeOfficeRoom());
+  KinectNoise noise;
+  noise.coefficient = 1.0;
+  const auto poses = roomTour(frames);
+  std::vector<RenderedFrame> rendered;
+  for (int f = 0; f < frames; ++f) rendered.push_back(renderer.render(poses[f], noise, 500 + f));
+
+  PlaneDetector detector{DetectorParams()};
+  const MethodStats ours = benchStages(renderer, rendered, detector);
+  benchVariants(rendered);
   const MemoryReport mem = detector.memory();
   std::printf("Hough space (resolution 1024): %.2f MB in %zu chunks = %.3f %% of the dense %.0f MB array "
               "(%.4f %% of a 1024^3 float array)\n\n",
@@ -105,19 +162,7 @@ int main(int argc, char** argv)
 
   // Comparators on every 4th frame (RANSAC is slow), in the same process.
   MethodStats ransac, organized;
-  for (int f = 0; f < frames; f += 4)
-  {
-    auto cloud = toPclCloud(rendered[f].view());
-    auto t = Clock::now();
-    const auto r = pclRansacPlanes(cloud, 500, 0.02, 2000);
-    ransac.ms.push_back(msSince(t));
-    ransac.add(evaluateFrame(renderer.truePlanes(), rendered[f].visible_points, 2000, planesToWorld(r, rendered[f].camera_to_world)));
-    t = Clock::now();
-    const auto o = pclOrganizedPlanes(cloud, 2000);
-    organized.ms.push_back(msSince(t));
-    organized.add(evaluateFrame(renderer.truePlanes(), rendered[f].visible_points, 2000,
-                                planesToWorld(o, rendered[f].camera_to_world)));
-  }
+  for (int f = 0; f < frames; f += 4) runComparators(rendered[f], renderer.truePlanes(), 500, 0.02, 2000, ransac, organized);
   std::printf("accuracy and time on the rendered frames (planes with >= 2000 visible points):\n");
   std::printf("  %-34s %8s %8s %8s   %-6s   %-6s   %-7s   %s\n", "method", "median", "p10", "p90", "E_ang", "E_d",
               "found", "false/frame");
@@ -126,51 +171,6 @@ int main(int argc, char** argv)
   printStats(organized, "PCL OrganizedMultiPlaneSegm.");
   std::printf("  speed-up: %.1fx vs PCL RANSAC, %.1fx vs PCL organized segmentation\n\n",
               median(ransac.ms) / median(ours.ms), median(organized.ms) / median(ours.ms));
-
-  // Real Kinect frames, a still camera.
-  if (argc > 1)
-  {
-    PlaneDetector real{DetectorParams()};
-    std::vector<double> ours_ms, ransac_ms, organized_ms;
-    size_t ours_planes = 0, ransac_planes = 0, organized_planes = 0;
-    for (int rep = 0; rep < 5; ++rep)
-      for (int i = 1; i < argc; ++i)
-      {
-        pcl::PCLPointCloud2 blob;
-        std::string error;
-        if (!loadPcd(argv[i], blob, &error))
-        {
-          std::fprintf(stderr, "%s\n", error.c_str());
-          return 1;
-        }
-        CloudView view;
-        std::vector<float> converted;
-        if (!makeCloudView(layoutOf(blob), view, converted, &error) || !real.processFrame(view, Eigen::Isometry3d::Identity(), rep * argc + i, &error))
-        {
-          std::fprintf(stderr, "%s: %s\n", argv[i], error.c_str());
-          return 1;
-        }
-        ours_ms.push_back(real.lastTimings().total_ms);
-        ours_planes = real.planes().size();
-        if (rep > 0) continue;
-        auto cloud = toPclCloud(view);
-        auto t = Clock::now();
-        ransac_planes = pclRansacPlanes(cloud, 500, 0.02, 2000).size();
-        ransac_ms.push_back(msSince(t));
-        t = Clock::now();
-        organized_planes = pclOrganizedPlanes(cloud, 2000).size();
-        organized_ms.push_back(msSince(t));
-      }
-    std::printf("real Kinect frames (%d PCD files, still camera): median ms per frame and planes found\n", argc - 1);
-    std::printf("  %-34s %8.2f ms  %zu planes in the map\n", "hough_plane_detector", median(ours_ms), ours_planes);
-    std::printf("  %-34s %8.2f ms  %zu planes (last frame)\n", "PCL RANSAC (2 cm, 500 it, LSQ)", median(ransac_ms), ransac_planes);
-    std::printf("  %-34s %8.2f ms  %zu planes (last frame)\n", "PCL OrganizedMultiPlaneSegm.", median(organized_ms),
-                organized_planes);
-    std::printf("  speed-up: %.1fx vs PCL RANSAC, %.1fx vs PCL organized segmentation\n", median(ransac_ms) / median(ours_ms),
-                median(organized_ms) / median(ours_ms));
-    for (const auto& p : real.planes())
-      std::printf("    plane %d: n = (%+.3f %+.3f %+.3f), d = %+.3f, support %d\n", p.id, p.normal.x(), p.normal.y(),
-                  p.normal.z(), p.d, p.support);
-  }
+  if (argc > 1 && !benchRealFrames(std::vector<std::string>(argv + 1, argv + argc))) return 1;
   return 0;
 }

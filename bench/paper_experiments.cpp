@@ -51,21 +51,6 @@ DetectorParams paperParamsFor(double noise, int resolution)
   return p;
 }
 
-// Runs both PCL methods on one frame and scores them against the scene's truth.
-void runComparators(const RenderedFrame& frame, const std::vector<TruePlane>& truth, int ransac_iterations,
-                    double threshold, MethodStats& ransac, MethodStats& organized)
-{
-  const auto cloud = toPclCloud(frame.view());
-  auto t = Clock::now();
-  const auto r = pclRansacPlanes(cloud, ransac_iterations, threshold, kMinVisiblePoints);
-  ransac.ms.push_back(msSince(t));
-  ransac.add(evaluateFrame(truth, frame.visible_points, kMinVisiblePoints, planesToWorld(r, frame.camera_to_world)));
-  t = Clock::now();
-  const auto o = pclOrganizedPlanes(cloud, kMinVisiblePoints);
-  organized.ms.push_back(msSince(t));
-  organized.add(evaluateFrame(truth, frame.visible_points, kMinVisiblePoints, planesToWorld(o, frame.camera_to_world)));
-}
-
 std::vector<RenderedFrame> renderSequence(const SceneRenderer& renderer, const std::vector<Eigen::Isometry3d>& poses,
                                           double noise, uint32_t seed)
 {
@@ -144,8 +129,8 @@ TourResult runTour(const Scene& scene, const std::vector<Eigen::Isometry3d>& pos
       ++causes[cause];
     }
     if (with_pcl)
-      runComparators(rendered[f], truth, kRoomRansacIterations, ransacThreshold(kRoomNoise), result.ransac,
-                     result.organized);
+      runComparators(rendered[f], truth, kRoomRansacIterations, ransacThreshold(kRoomNoise), kMinVisiblePoints,
+                     result.ransac, result.organized);
   }
   return result;
 }
@@ -193,7 +178,7 @@ NoiseExperiment runNoiseExperiment(bool quick)
     {
       std::fprintf(stderr, "    PCL methods on frame %d\n", f);
       runComparators(rendered[f], renderer.truePlanes(), result.ransac_iterations, ransacThreshold(noise),
-                     level.ransac, level.organized);
+                     kMinVisiblePoints, level.ransac, level.organized);
     }
     result.levels.push_back(level);
   }

@@ -9,6 +9,8 @@
 #include <pcl/segmentation/organized_multi_plane_segmentation.h>
 #include <pcl/segmentation/sac_segmentation.h>
 
+#include "stopwatch.h"
+
 namespace hough_plane_detector
 {
 
@@ -139,6 +141,20 @@ void MethodStats::merge(const MethodStats& other)
   detected += other.detected;
   false_detections += other.false_detections;
   frames += other.frames;
+}
+
+void runComparators(const RenderedFrame& frame, const std::vector<TruePlane>& truth, int ransac_iterations,
+                    double ransac_threshold, int min_inliers, MethodStats& ransac, MethodStats& organized)
+{
+  const auto cloud = toPclCloud(frame.view());
+  auto t = Clock::now();
+  const auto r = pclRansacPlanes(cloud, ransac_iterations, ransac_threshold, min_inliers);
+  ransac.ms.push_back(msSince(t));
+  ransac.add(evaluateFrame(truth, frame.visible_points, min_inliers, planesToWorld(r, frame.camera_to_world)));
+  t = Clock::now();
+  const auto o = pclOrganizedPlanes(cloud, min_inliers);
+  organized.ms.push_back(msSince(t));
+  organized.add(evaluateFrame(truth, frame.visible_points, min_inliers, planesToWorld(o, frame.camera_to_world)));
 }
 
 }  // namespace hough_plane_detector

@@ -46,4 +46,9 @@ struct MethodStats
   void merge(const MethodStats& other);
 };
 
+// Both PCL methods on one rendered frame (planes of min_inliers points), timed and scored
+// against the scene's truth with the same matching as ours.
+void runComparators(const RenderedFrame& frame, const std::vector<TruePlane>& truth, int ransac_iterations,
+                    double ransac_threshold, int min_inliers, MethodStats& ransac, MethodStats& organized);
+
 }  // namespace hough_plane_detector
