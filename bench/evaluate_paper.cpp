@@ -200,6 +200,32 @@ std::string missTable(const std::string& scene, const TourResult& tour)
   return rows;
 }
 
+// 4.6.4: timing from the Table 3 runs (every frame for ours, the scored frames for PCL's).
+void writeTiming(const MethodStats& all_ours, const MethodStats& all_ransac, const MethodStats& all_organized,
+                 Report& report)
+{
+  auto file = report.data("timing.dat");
+  file << "# method, median ms, p10, p90, mean, std\n";
+  report.md << "## Time per frame (4.6.4)\n\n"
+            << "From the Table 3 runs above: one thread, one method at a time, 640 x 480 frames, on this machine.\n\n"
+            << "| method | median (ms) | p10 | p90 | mean +- std | frames | ours faster by (median) |\n"
+               "|---|---|---|---|---|---|---|\n";
+  const std::pair<const char*, const MethodStats*> methods[] = {
+      {"Hough_1024", &all_ours}, {"PCL_RANSAC", &all_ransac}, {"PCL_OMPS", &all_organized}};
+  for (const auto& [name, s] : methods)
+  {
+    file << '"' << name << "\" " << median(s->ms) << ' ' << percentile(s->ms, 0.1) << ' ' << percentile(s->ms, 0.9)
+         << ' ' << mean(s->ms) << ' ' << standardDeviation(s->ms) << '\n';
+    report.md << fmt("| %s | %.2f | %.2f | %.2f | %.2f +- %.2f | %zu | %.1fx |\n", name, median(s->ms),
+                     percentile(s->ms, 0.1), percentile(s->ms, 0.9), mean(s->ms), standardDeviation(s->ms),
+                     s->ms.size(), median(s->ms) / median(all_ours.ms));
+  }
+  report.md << "\n![time per frame](results/timing.png)\n\n";
+  for (const auto& [name, other] : {methods[1], methods[2]})
+    report.verdict(median(other->ms) >= 10.0 * median(all_ours.ms),
+                   fmt("timing: at least 10x faster than %s (%.1fx)", name, median(other->ms) / median(all_ours.ms)));
+}
+
 // Table 3 and 4.6.4.
 void writeRoomTours(const RoomExperiment& e, Report& report)
 {
@@ -263,27 +289,7 @@ void writeRoomTours(const RoomExperiment& e, Report& report)
                        all_ours.falsePerFrame(), other->falsePerFrame()));
   }
 
-  // Timing from the same runs: every frame for ours, the scored frames for PCL's methods.
-  auto file = report.data("timing.dat");
-  file << "# method, median ms, p10, p90, mean, std\n";
-  report.md << "## Time per frame (4.6.4)\n\n"
-            << "From the Table 3 runs above: one thread, one method at a time, 640 x 480 frames, on this machine.\n\n"
-            << "| method | median (ms) | p10 | p90 | mean +- std | frames | ours faster by (median) |\n"
-               "|---|---|---|---|---|---|---|\n";
-  const std::pair<const char*, const MethodStats*> methods[] = {
-      {"Hough_1024", &all_ours}, {"PCL_RANSAC", &all_ransac}, {"PCL_OMPS", &all_organized}};
-  for (const auto& [name, s] : methods)
-  {
-    file << '"' << name << "\" " << median(s->ms) << ' ' << percentile(s->ms, 0.1) << ' ' << percentile(s->ms, 0.9)
-         << ' ' << mean(s->ms) << ' ' << standardDeviation(s->ms) << '\n';
-    report.md << fmt("| %s | %.2f | %.2f | %.2f | %.2f +- %.2f | %zu | %.1fx |\n", name, median(s->ms),
-                     percentile(s->ms, 0.1), percentile(s->ms, 0.9), mean(s->ms), standardDeviation(s->ms),
-                     s->ms.size(), median(s->ms) / median(all_ours.ms));
-  }
-  report.md << "\n![time per frame](results/timing.png)\n\n";
-  for (const auto& [name, other] : {methods[1], methods[2]})
-    report.verdict(median(other->ms) >= 10.0 * median(all_ours.ms),
-                   fmt("timing: at least 10x faster than %s (%.1fx)", name, median(other->ms) / median(all_ours.ms)));
+  writeTiming(all_ours, all_ransac, all_organized, report);
 }
 
 // Table 3's scenes along other paths: its thresholds were chosen while looking at Table 3's
