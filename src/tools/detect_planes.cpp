@@ -12,6 +12,99 @@
 using namespace hough_plane_detector;
 namespace po = boost::program_options;
 
+namespace
+{
+// Detects in each frame given and writes its JSON line; counts frames.
+class FrameWriter
+{
+public:
+  FrameWriter(const DetectorParams& params, std::ostream& out) : detector_(params), out_(out) {}
+
+  // False (message on stderr, the frame counted) when the cloud cannot be viewed or detected in.
+  bool process(const PointBufferLayout& layout, const Eigen::Isometry3d& pose, double stamp, const std::string& frame_id,
+               const std::string& what)
+  {
+    CloudView view;
+    std::vector<float> converted;
+    std::string error;
+    if (!makeCloudView(layout, view, converted, &error) || !detector_.processFrame(view, pose, stamp, &error))
+    {
+      std::cerr << "detect_planes: " << what << ": " << error << "\n";
+      ++frame_index_;
+      return false;
+    }
+    std::vector<std::vector<PlaneOutline>> outlines;
+    for (const DetectedPlane& plane : detector_.planes()) outlines.push_back(detector_.outlines(plane));
+    out_ << frameToJson(frame_index_++, stamp, frame_id, detector_.lastTimings().total_ms, detector_.planes(), outlines)
+         << "\n";
+    ++processed_;
+    return true;
+  }
+  void skip() { ++frame_index_; }
+  int frameIndex() const { return frame_index_; }
+  int processed() const { return processed_; }
+
+private:
+  PlaneDetector detector_;
+  std::ostream& out_;
+  int frame_index_ = 0, processed_ = 0;
+};
+
+// PCD files: each one frame of a still camera (the camera frame is the world frame).
+int detectInPcds(const std::vector<std::string>& paths, FrameWriter& writer)
+{
+  for (const std::string& path : paths)
+  {
+    pcl::PCLPointCloud2 cloud;
+    std::string error;
+    if (!loadPcd(path, cloud, &error))
+    {
+      std::cerr << "detect_planes: " << error << "\n";
+      return 1;
+    }
+    if (!writer.process(layoutOf(cloud), Eigen::Isometry3d::Identity(), cloud.header.stamp * 1e-6,
+                        cloud.header.frame_id.empty() ? "camera" : cloud.header.frame_id, path))
+      return 1;
+  }
+  return 0;
+}
+
+// A bag's clouds or depth images in world_frame; frames without a transform are skipped.
+int detectInBag(const std::string& bag_path, const std::string& topic, const std::string& world_frame,
+                const std::string& camera_info_topic, FrameWriter& writer)
+{
+  BagFrameSource source;
+  std::string error;
+  if (!source.open(bag_path, topic, world_frame, &error, camera_info_topic))
+  {
+    std::cerr << "detect_planes: " << error << "\n";
+    return 1;
+  }
+  BagFrame frame;
+  int skipped = 0;
+  while (source.next(frame))
+  {
+    const double stamp = frame.cloud->header.stamp.toSec();
+    if (!frame.usable)
+    {
+      std::cerr << "detect_planes: warning: frame " << writer.frameIndex() << " skipped: " << frame.skip_reason << "\n";
+      writer.skip();
+      ++skipped;
+      continue;
+    }
+    if (!writer.process(layoutOf(*frame.cloud), frame.camera_to_world, stamp, world_frame,
+                        "frame " + std::to_string(writer.frameIndex()) + " of " + topic))
+      ++skipped;
+  }
+  if (writer.processed() == 0)
+  {
+    std::cerr << "detect_planes: no frame of " << topic << " could be processed (" << skipped << " skipped)\n";
+    return 1;
+  }
+  return 0;
+}
+}  // namespace
+
 int main(int argc, char** argv)
 {
   std::string bag_path, topic, world_frame, out_path, camera_info_topic;
@@ -75,74 +168,7 @@ int main(int argc, char** argv)
     }
   }
   std::ostream& out = out_path.empty() ? std::cout : out_file;
-  PlaneDetector detector(params);
-  int frame_index = 0, processed = 0;
-
-  auto run = [&](const PointBufferLayout& layout, const Eigen::Isometry3d& pose, double stamp,
-                 const std::string& frame_id, const std::string& what) {
-    CloudView view;
-    std::vector<float> converted;
-    std::string error;
-    if (!makeCloudView(layout, view, converted, &error) || !detector.processFrame(view, pose, stamp, &error))
-    {
-      std::cerr << "detect_planes: " << what << ": " << error << "\n";
-      ++frame_index;
-      return false;
-    }
-    std::vector<std::vector<PlaneOutline>> outlines;
-    for (const DetectedPlane& plane : detector.planes()) outlines.push_back(detector.outlines(plane));
-    out << frameToJson(frame_index++, stamp, frame_id, detector.lastTimings().total_ms, detector.planes(), outlines)
-        << "\n";
-    ++processed;
-    return true;
-  };
-
-  if (!pcd_paths.empty())
-  {
-    for (const std::string& path : pcd_paths)
-    {
-      pcl::PCLPointCloud2 cloud;
-      std::string error;
-      if (!loadPcd(path, cloud, &error))
-      {
-        std::cerr << "detect_planes: " << error << "\n";
-        return 1;
-      }
-      // A still camera: the camera frame is the world frame.
-      if (!run(layoutOf(cloud), Eigen::Isometry3d::Identity(), cloud.header.stamp * 1e-6,
-               cloud.header.frame_id.empty() ? "camera" : cloud.header.frame_id, path))
-        return 1;
-    }
-    return 0;
-  }
-
-  BagFrameSource source;
-  std::string error;
-  if (!source.open(bag_path, topic, world_frame, &error, camera_info_topic))
-  {
-    std::cerr << "detect_planes: " << error << "\n";
-    return 1;
-  }
-  BagFrame frame;
-  int skipped = 0;
-  while (source.next(frame))
-  {
-    const double stamp = frame.cloud->header.stamp.toSec();
-    if (!frame.usable)
-    {
-      std::cerr << "detect_planes: warning: frame " << frame_index << " skipped: " << frame.skip_reason << "\n";
-      ++frame_index;
-      ++skipped;
-      continue;
-    }
-    if (!run(layoutOf(*frame.cloud), frame.camera_to_world, stamp, world_frame,
-             "frame " + std::to_string(frame_index) + " of " + topic))
-      ++skipped;
-  }
-  if (processed == 0)
-  {
-    std::cerr << "detect_planes: no frame of " << topic << " could be processed (" << skipped << " skipped)\n";
-    return 1;
-  }
-  return 0;
+  FrameWriter writer(params, out);
+  return pcd_paths.empty() ? detectInBag(bag_path, topic, world_frame, camera_info_topic, writer)
+                           : detectInPcds(pcd_paths, writer);
 }
