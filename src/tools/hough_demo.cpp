@@ -13,6 +13,37 @@
 
 using namespace hough_plane_detector;
 
+namespace
+{
+// The map's planes, each beside the true plane nearest it (if within twice the match tolerance).
+void printMap(const PlaneDetector& detector, const SceneRenderer& renderer, int frames)
+{
+  std::printf("\nplanes in the map after %d frames (world frame, n.p + d = 0):\n", frames);
+  std::printf("  id  normal                      d        strength  support  | true plane            E_angle  E_d\n");
+  for (const auto& p : detector.planes())
+  {
+    const TruePlane* best = nullptr;
+    double best_cost = 1e9;
+    for (const auto& t : renderer.truePlanes())
+    {
+      const double cost = angleError(p.normal, t.normal) / 0.08 + distanceError(p.normal, p.d, t.normal, t.d) / 0.07;
+      if (cost < best_cost)
+      {
+        best_cost = cost;
+        best = &t;
+      }
+    }
+    std::printf("  %2d  (%+.3f %+.3f %+.3f)  %+7.3f  %8.2f  %7d  | ", p.id, p.normal.x(), p.normal.y(), p.normal.z(),
+                p.d, p.strength, p.support);
+    if (best && best_cost <= 2.0)
+      std::printf("%-20s  %.4f   %.4f\n", best->name.c_str(), angleError(p.normal, best->normal),
+                  distanceError(p.normal, p.d, best->normal, best->d));
+    else
+      std::printf("(no true plane)\n");
+  }
+}
+}  // namespace
+
 int main(int argc, char** argv)
 {
   namespace po = boost::program_options;
@@ -88,29 +119,7 @@ int main(int argc, char** argv)
     d_errors.insert(d_errors.end(), m.d_errors.begin(), m.d_errors.end());
   }
 
-  std::printf("\nplanes in the map after %d frames (world frame, n.p + d = 0):\n", frames);
-  std::printf("  id  normal                      d        strength  support  | true plane            E_angle  E_d\n");
-  for (const auto& p : detector.planes())
-  {
-    const TruePlane* best = nullptr;
-    double best_cost = 1e9;
-    for (const auto& t : renderer.truePlanes())
-    {
-      const double cost = angleError(p.normal, t.normal) / 0.08 + distanceError(p.normal, p.d, t.normal, t.d) / 0.07;
-      if (cost < best_cost)
-      {
-        best_cost = cost;
-        best = &t;
-      }
-    }
-    std::printf("  %2d  (%+.3f %+.3f %+.3f)  %+7.3f  %8.2f  %7d  | ", p.id, p.normal.x(), p.normal.y(), p.normal.z(),
-                p.d, p.strength, p.support);
-    if (best && best_cost <= 2.0)
-      std::printf("%-20s  %.4f   %.4f\n", best->name.c_str(), angleError(p.normal, best->normal),
-                  distanceError(p.normal, p.d, best->normal, best->d));
-    else
-      std::printf("(no true plane)\n");
-  }
+  printMap(detector, renderer, frames);
   auto mean = [](const std::vector<double>& v) {
     double s = 0;
     for (double x : v) s += x;
