@@ -259,8 +259,6 @@ bool FramePlaneFitter::normalDetermined(const std::vector<int>& blocks) const
 {
   // Within merge_angle at two sigmas, so that every frame's fit of the surface lands on one
   // Hough peak; a plane the points cannot orient (a strip along a shelf's edge) is no plane.
-  // (At three sigmas, merge_angle / 3, osd-learn loses 80.5 -> 76.3 % for fewer false planes on
-  // Table 3's other tours, 0.140 -> 0.096 per frame, and more on the tuning rooms, 0.07 -> 0.11.)
   return tests_.normalUncertainty(blocks) <= params_.merge_angle / 2.0;
 }
 
