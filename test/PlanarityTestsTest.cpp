@@ -1,0 +1,79 @@
+// The planarity tests of a per-frame plane on rendered frames.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hough_plane_detector/core/planarity_tests.h"
+#include "frame_fixture.h"
+
+using namespace hough_plane_detector;
+using namespace hough_plane_detector::test;
+
+TEST(PlanarityTests, AWallPassesAndAPillarFails)
+{
+  Frame f;
+  const std::vector<int> wall = f.blocksOn(f.truePlane("wall"));
+  const std::vector<int> pillar = f.blocksOn(-1);
+  ASSERT_GT(wall.size(), 100u);
+  ASSERT_GT(pillar.size(), 30u);
+  EXPECT_TRUE(f.tests.isPlanarFit(f.tests.weightedMoments(wall), wall));
+  EXPECT_TRUE(f.tests.halvesAgree(wall, 0, wall.size(), f.params.merge_angle));
+  EXPECT_FALSE(f.tests.isPlanarFit(f.tests.weightedMoments(pillar), pillar));
+}
+
+TEST(PlanarityTests, AFaceBowedLikeCardboardPassesACanFails)
+{
+  // Real box faces bow by about 1/m (osd-learn); a can's side turns 30 times as fast. Both
+  // patches are 15 cm wide, 1 m ahead: their halves tilt apart by more than merge_angle and
+  // far beyond the noise, but only the can bends faster than a plane may (kMaxPlaneCurvature).
+  for (const double radius : {1.0, 0.25})
+  {
+    Scene scene;
+    scene.cylinders.push_back({Eigen::Vector3d(1.0 + radius, 0, 0), radius, 2.0});
+    Frame f(scene, lookAt(Eigen::Vector3d(0, 0, 1.0), Eigen::Vector3d(1, 0, 1.0)));
+    std::vector<int> patch;
+    for (int b : f.blocksOn(-1))
+      if (std::abs(f.frame.blocks[b].centroid.x()) < 0.075 && std::abs(f.frame.blocks[b].centroid.y()) < 0.2)
+        patch.push_back(b);
+    ASSERT_GT(patch.size(), 60u) << "radius " << radius;
+    EXPECT_EQ(f.tests.halvesAgree(patch, 0, patch.size(), f.params.merge_angle), radius > 1.0 / kMaxPlaneCurvature)
+        << "radius " << radius;
+  }
+}
+
+TEST(PlanarityTests, TheLikelihoodRatioTellsTheTrueNormalFromOneDegreeOff)
+{
+  Frame f;
+  const std::vector<int> wall = f.blocksOn(f.truePlane("wall"));
+  const Eigen::Vector3d n_cam = f.frame.normalInCamera(f.renderer.truePlanes()[f.truePlane("wall")].normal);
+  EXPECT_TRUE(f.tests.explainedByNormal(n_cam, wall));
+  const Eigen::Vector3d tilted = Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d::UnitX()) * n_cam;
+  EXPECT_GT(f.tests.snapChi2Increase(tilted, wall), kMaxSnapChi2Increase);
+  EXPECT_FALSE(f.tests.explainedByNormal(tilted, wall));
+}
+
+TEST(PlanarityTests, ANormalNeedsSpreadAcrossMoreThanAFewBlocks)
+{
+  Frame f;
+  const std::vector<int> wall = f.blocksOn(f.truePlane("wall"));
+  ASSERT_GT(wall.size(), 100u);
+  const double bound = f.params.merge_angle / 2.0;  // FramePlaneFitter's limit
+  EXPECT_LT(f.tests.normalUncertainty(wall), 0.2 * bound);
+  // One image row of the wall's blocks: a line in space, no tilt about it is measured.
+  const int row = f.wallRow(wall);
+  std::vector<int> strip;
+  for (int b : wall)
+    if (b / f.frame.blocksX() == row) strip.push_back(b);
+  ASSERT_GT(strip.size(), 20u);
+  EXPECT_GT(f.tests.normalUncertainty(strip), bound);
+  // Nor may a few blocks off the row (a strip along a shelf's edge and some on the wall).
+  int added = 0;
+  for (int b : wall)
+    if (b / f.frame.blocksX() == row + 10 && added < 3) strip.push_back(b), ++added;
+  ASSERT_EQ(added, 3);
+  EXPECT_GT(f.tests.normalUncertainty(strip), bound);
+  // Three rows do.
+  for (int b : wall)
+    if (b / f.frame.blocksX() == row + 1 || b / f.frame.blocksX() == row + 2) strip.push_back(b);
+  EXPECT_LT(f.tests.normalUncertainty(strip), bound);
+}
