@@ -1,0 +1,80 @@
+// Block statistics and region growing on a rendered frame: a floor, a wall 3.5 m ahead, a step
+// before it and a pillar.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "hough_plane_detector/core/block_regions.h"
+#include "frame_fixture.h"
+
+using namespace hough_plane_detector;
+using namespace hough_plane_detector::test;
+
+namespace
+{
+// Share of `blocks` whose pixels lie on true plane `index`.
+double shareOn(const Frame& f, const std::vector<int>& blocks, int index)
+{
+  const std::vector<int> on = f.blocksOn(index);
+  int inside = 0;
+  for (int b : blocks) inside += std::find(on.begin(), on.end(), b) != on.end();
+  return blocks.empty() ? 0.0 : static_cast<double>(inside) / blocks.size();
+}
+}  // namespace
+
+TEST(BlockRegions, BlocksOfTheWallAreFlatAndFaceTheirPlane)
+{
+  Frame f;
+  const TruePlane& wall = f.renderer.truePlanes()[f.truePlane("wall")];
+  const Eigen::Vector3d n_cam = f.frame.normalInCamera(wall.normal);
+  const std::vector<int> blocks = f.blocksOn(f.truePlane("wall"));
+  ASSERT_GT(blocks.size(), 100u);
+  int planar = 0, within_tolerance = 0;
+  for (int b : blocks)
+  {
+    const BlockInfo& info = f.frame.blocks[b];
+    planar += info.planar;
+    const double angle = std::acos(std::min(1.0, std::abs(info.normal.dot(n_cam))));
+    within_tolerance += angle <= info.normal_tolerance;
+    // The centroid lies on the true plane within the residual a region allows it.
+    EXPECT_LE(std::abs(n_cam.dot(info.centroid) + f.frame.dInCamera(wall.normal, wall.d)), info.region_residual) << b;
+  }
+  EXPECT_GE(planar, 0.95 * blocks.size());
+  EXPECT_GE(within_tolerance, 0.95 * blocks.size());
+}
+
+TEST(BlockRegions, TheWallGrowsOverItselfAndNotOntoTheFloor)
+{
+  Frame f;
+  const TruePlane& wall = f.renderer.truePlanes()[f.truePlane("wall")];
+  const Eigen::Vector3d n_cam = f.frame.normalInCamera(wall.normal);
+  const double d_cam = f.frame.dInCamera(wall.normal, wall.d);
+  BlockRegionGrower grower(f.frame.normals, f.frame.blocks, f.params);
+  const std::vector<char> taken(f.frame.blocks.size(), 0);
+  const auto seeds = grower.seedComponents(n_cam, d_cam, taken);
+  ASSERT_FALSE(seeds.empty());
+  const PlaneRegion region = grower.grow(seeds.front(), n_cam, d_cam, taken);
+  // Nearly every block of the region is on the wall (rim blocks may straddle its edges), and it
+  // covers most of the wall's whole blocks.
+  EXPECT_GE(shareOn(f, region.blocks, f.truePlane("wall")), 0.9);
+  EXPECT_GE(region.blocks.size(), 0.8 * f.blocksOn(f.truePlane("wall")).size());
+  EXPECT_LT(std::acos(std::min(1.0, std::abs(region.normal.dot(n_cam)))), 0.01);
+  EXPECT_NEAR(region.d, d_cam, 0.02);
+  EXPECT_EQ(shareOn(f, region.blocks, f.truePlane("floor")), 0.0);
+}
+
+TEST(BlockRegions, ThePillarsCentroidsBendAndTheWallsDoNot)
+{
+  Frame f;
+  BlockRegionGrower grower(f.frame.normals, f.frame.blocks, f.params);
+  const std::vector<int> pillar = f.blocksOn(-1), wall = f.blocksOn(f.truePlane("wall"));
+  ASSERT_GT(pillar.size(), 30u);
+  Eigen::Vector3d normal;
+  double d;
+  ASSERT_TRUE(grower.fit(pillar, normal, d));
+  EXPECT_TRUE(grower.centroidsBend(pillar, normal, d));
+  ASSERT_TRUE(grower.fit(wall, normal, d));
+  EXPECT_FALSE(grower.centroidsBend(wall, normal, d));
+  EXPECT_FALSE(grower.normalsTurn(wall, normal));
+}
