@@ -26,6 +26,23 @@ std::vector<EvaluatedPlane> evaluatedPlanes(const std::vector<DetectedPlane>& pl
   return out;
 }
 
+const TruePlane* nearestTruePlane(const Eigen::Vector3d& normal, double d, const std::vector<TruePlane>& truth,
+                                  double max_cost, const MatchTolerance& tolerance)
+{
+  const TruePlane* best = nullptr;
+  double best_cost = max_cost;
+  for (const TruePlane& t : truth)
+  {
+    const double cost = angleError(normal, t.normal) / tolerance.angle + distanceError(normal, d, t.normal, t.d) / tolerance.distance;
+    if (cost <= best_cost)
+    {
+      best_cost = cost;
+      best = &t;
+    }
+  }
+  return best;
+}
+
 FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std::vector<int>& visible_points,
                            int min_visible_points, const std::vector<EvaluatedPlane>& detections,
                            const MatchTolerance& tolerance)

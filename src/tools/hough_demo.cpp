@@ -22,20 +22,10 @@ void printMap(const PlaneDetector& detector, const SceneRenderer& renderer, int 
   std::printf("  id  normal                      d        strength  support  | true plane            E_angle  E_d\n");
   for (const auto& p : detector.planes())
   {
-    const TruePlane* best = nullptr;
-    double best_cost = 1e9;
-    for (const auto& t : renderer.truePlanes())
-    {
-      const double cost = angleError(p.normal, t.normal) / 0.08 + distanceError(p.normal, p.d, t.normal, t.d) / 0.07;
-      if (cost < best_cost)
-      {
-        best_cost = cost;
-        best = &t;
-      }
-    }
+    const TruePlane* best = nearestTruePlane(p.normal, p.d, renderer.truePlanes());
     std::printf("  %2d  (%+.3f %+.3f %+.3f)  %+7.3f  %8.2f  %7d  | ", p.id, p.normal.x(), p.normal.y(), p.normal.z(),
                 p.d, p.strength, p.support);
-    if (best && best_cost <= 2.0)
+    if (best)
       std::printf("%-20s  %.4f   %.4f\n", best->name.c_str(), angleError(p.normal, best->normal),
                   distanceError(p.normal, p.d, best->normal, best->d));
     else

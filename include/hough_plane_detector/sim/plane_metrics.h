@@ -42,6 +42,11 @@ double angleError(const Eigen::Vector3d& normal, const Eigen::Vector3d& true_nor
 // E_d after aligning the sign of the normal with the true one.
 double distanceError(const Eigen::Vector3d& normal, double d, const Eigen::Vector3d& true_normal, double true_d);
 
+// The true plane closest to (normal, d) in units of the match tolerance (angle / tolerance.angle
+// + distance / tolerance.distance), if that cost is at most max_cost; else nullptr.
+const TruePlane* nearestTruePlane(const Eigen::Vector3d& normal, double d, const std::vector<TruePlane>& truth,
+                                  double max_cost = 2.0, const MatchTolerance& tolerance = MatchTolerance());
+
 // One-to-one matching (closest pairs first, visible planes before hidden ones) of detections to all
 // true planes of the scene; planes with at least min_visible_points count as visible.
 FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std::vector<int>& visible_points,
