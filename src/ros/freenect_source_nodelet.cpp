@@ -155,19 +155,30 @@ private:
 
   // Sets fx = fy from the device's zero-plane data, as libfreenect's own freenect_camera_to_world
   // does (a pixel of reference_pixel_size mm at SXGA, so twice that at VGA, seen reference_distance
-  // mm away); says where the focal length came from. Looked up at run time: fakenect's
-  // libfreenect has no registration, and a direct call would keep the nodelet from loading there.
+  // mm away); says where the focal length came from. Looked up at run time in the libfreenect
+  // actually loaded: fakenect's has no registration, and a direct call would keep the nodelet from
+  // loading there (RTLD_DEFAULT would not see a library the nodelet manager loaded locally).
   std::string deviceFocalLength()
   {
     using CopyRegistration = freenect_registration (*)(freenect_device*);
     using DestroyRegistration = int (*)(freenect_registration*);
-    const auto copy = reinterpret_cast<CopyRegistration>(dlsym(RTLD_DEFAULT, "freenect_copy_registration"));
-    const auto destroy = reinterpret_cast<DestroyRegistration>(dlsym(RTLD_DEFAULT, "freenect_destroy_registration"));
-    if (!copy || !destroy) return "nominal: this libfreenect (fakenect?) has no registration data";
+    Dl_info library;
+    void* handle = nullptr;
+    if (dladdr(reinterpret_cast<void*>(&freenect_init), &library) && library.dli_fname)
+      handle = dlopen(library.dli_fname, RTLD_LAZY | RTLD_NOLOAD);
+    if (!handle) return "nominal: the loaded libfreenect could not be inspected";
+    const auto copy = reinterpret_cast<CopyRegistration>(dlsym(handle, "freenect_copy_registration"));
+    const auto destroy = reinterpret_cast<DestroyRegistration>(dlsym(handle, "freenect_destroy_registration"));
+    if (!copy || !destroy)
+    {
+      dlclose(handle);
+      return "nominal: this libfreenect (fakenect?) has no registration data";
+    }
     freenect_registration registration = copy(device_);
     const double distance = registration.zero_plane_info.reference_distance;
     const double pixel = registration.zero_plane_info.reference_pixel_size;
     destroy(&registration);
+    dlclose(handle);
     const double focal = distance / (2.0 * pixel);
     if (!(distance > 0.0 && pixel > 0.0 && focal > 100.0 && focal < 2000.0))
       return "nominal: the device's registration data gave no usable focal length";
