@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <thread>
 #include <vector>
@@ -143,7 +144,7 @@ private:
     height_ = mode.height;
     freenect_set_user(device_, this);
     freenect_set_depth_callback(device_, [](freenect_device* device, void* depth, uint32_t timestamp) {
-      static_cast<FreenectSourceNodelet*>(freenect_get_user(device))->onDepth(static_cast<const uint16_t*>(depth), timestamp);
+      static_cast<FreenectSourceNodelet*>(freenect_get_user(device))->onDepth(static_cast<const uint8_t*>(depth), timestamp);
     });
     if (freenect_start_depth(device_) < 0)
     {
@@ -197,7 +198,9 @@ private:
       }
   }
 
-  void onDepth(const uint16_t* raw, uint32_t ticks)
+  // `raw`: 16-bit disparities, not necessarily 2-byte aligned (fakenect hands on its file buffer
+  // just past the PGM header), so each is copied out, never dereferenced as uint16_t.
+  void onDepth(const uint8_t* raw, uint32_t ticks)
   {
     // The 32-bit frame counter wraps: unwrapped here, so the clock sees it grow.
     if (have_ticks_ && ticks < last_ticks_) wraps_ += uint64_t(1) << 32;
@@ -205,7 +208,12 @@ private:
     last_ticks_ = ticks;
     const ros::Time stamp = clock_.stamp(wraps_ + ticks, ros::Time::now());
     millimetres_.resize(static_cast<size_t>(width_) * height_);
-    for (size_t i = 0; i < millimetres_.size(); ++i) millimetres_[i] = kinectDisparityToMillimetres(raw[i], intrinsics_);
+    for (size_t i = 0; i < millimetres_.size(); ++i)
+    {
+      uint16_t disparity;
+      std::memcpy(&disparity, raw + 2 * i, sizeof(disparity));
+      millimetres_[i] = kinectDisparityToMillimetres(disparity, intrinsics_);
+    }
     publisher_.publish(millimetres_.data(), width_, height_, width_ * sizeof(uint16_t), intrinsics_, frame_id_, stamp);
   }
 
