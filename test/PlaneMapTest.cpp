@@ -88,16 +88,40 @@ TEST(PlaneMap, IdsFollowAPlaneThatMovesALittleAndNewPlanesGetNewOnes)
   }
 }
 
+// A plane one frame raised that no later frame supports: the paper's thinning takes it away at
+// thinning_rate a frame; forgetting by evidence (the default) takes a tentative plane away at
+// PlaneBelief::kTentativeFade a frame.
 TEST(PlaneMap, ThinningForgetsAPlaneNoFrameConfirms)
+{
+  for (int forgetting : {kForgetByThinning, kForgetByEvidence})
+  {
+    Map m;
+    m.params.forgetting = forgetting;
+    m.frame({m.plane(kFloor, 1.0, 20000)}, 0.0);
+    ASSERT_EQ(m.map.planes().size(), 1u);
+    // Peak 2 thins to below global_threshold after (2 - 1.5) / rate frames.
+    int frames_kept = 0;
+    for (int f = 1; f < 40 && !m.map.planes().empty(); ++f, ++frames_kept) m.frame({}, f);
+    EXPECT_TRUE(m.map.planes().empty());
+    const double rate = forgetting == kForgetByThinning ? m.params.thinning_rate : PlaneBelief::kTentativeFade;
+    EXPECT_NEAR(frames_kept, (2.0 - m.params.global_threshold) / rate, 1.5) << "forgetting " << forgetting;
+  }
+}
+
+// Forgetting by evidence: a tentative plane loses kTentativeFade only after a frame that did not
+// support it; after one that did, thinning_rate.
+TEST(PlaneMap, ATentativePlaneFadesOnlyAfterFramesThatDoNotSupportIt)
 {
   Map m;
   m.frame({m.plane(kFloor, 1.0, 20000)}, 0.0);
   ASSERT_EQ(m.map.planes().size(), 1u);
-  // Peak 2 thins by thinning_rate a frame: below global_threshold after (2 - 1.5) / 0.05 frames.
-  int frames_kept = 0;
-  for (int f = 1; f < 40 && !m.map.planes().empty(); ++f, ++frames_kept) m.frame({}, f);
+  const FrameData no_blocks;
+  m.map.observe({20000}, {}, no_blocks, 0.0);  // its own frame measured it
+  m.frame({}, 1.0);
+  EXPECT_EQ(m.map.planes().size(), 1u) << "a supported plane loses thinning_rate, not kTentativeFade";
+  m.map.observe({0}, {}, no_blocks, 1.0);  // not supported: tentative planes fade
+  for (int f = 2; f < 4; ++f) m.frame({}, f);
   EXPECT_TRUE(m.map.planes().empty());
-  EXPECT_NEAR(frames_kept, (2.0 - m.params.global_threshold) / m.params.thinning_rate, 1.5);
 }
 
 TEST(PlaneMap, SerialisesToItselfExactly)

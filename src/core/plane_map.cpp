@@ -217,7 +217,7 @@ void PlaneMap::thinByEvidence(float cap)
 {
   // The cells around each established map plane's peak (its blur and peak window, and the
   // mirrored copy near the border) are kept as they are, a gone plane's are cleared; a plane
-  // not yet established thins like everything else.
+  // not yet established thins like everything else, a tentative one faster.
   const int r = voting_.blurRadius() + params_.peak_window / 2 + 1;
   std::vector<std::pair<Eigen::Vector3i, float>> kept;
   auto forBox = [&](const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) {
@@ -247,6 +247,19 @@ void PlaneMap::thinByEvidence(float cap)
         const float v = global_.value(x, y, z);
         if (v > 0.0f) kept.emplace_back(Eigen::Vector3i(x, y, z), v);
       });
+  }
+  // A tentative plane (no frame after its first confirmed it) that the last frame did not support
+  // loses half a vote a frame, thinning included: one view's hypothesis leaves unless seen again,
+  // as a tracker's tentative tracks do (after the established planes' cells are noted above).
+  const float tentative_fade = static_cast<float>(std::max(0.0, PlaneBelief::kTentativeFade - params_.thinning_rate));
+  for (const DetectedPlane& plane : planes_)
+  {
+    const auto belief = beliefs_.find(plane.id);
+    if (belief == beliefs_.end() || !belief->second.tentative() || plane.support >= params_.min_support) continue;
+    forBox(plane.hough, [&](int x, int y, int z) {
+      const float v = global_.value(x, y, z);
+      if (v > 0.0f) global_.add(x, y, z, -std::min(v, tentative_fade));
+    });
   }
   global_.thin(static_cast<float>(params_.thinning_rate), cap);
   for (const auto& cell : kept)

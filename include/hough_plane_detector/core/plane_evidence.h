@@ -46,6 +46,8 @@ struct PlaneBelief
   // until then it fades as in the paper, so a plane one view suggested (a pillar's tangent)
   // does not stay for good once the camera turns away.
   static constexpr int64_t kEstablishedAfter = 6;
+  // Votes a tentative plane loses per frame that does not support it (a frame's vote adds 1).
+  static constexpr double kTentativeFade = 0.5;
 
   double log_odds = kStart;
   int64_t confirmations = 0;    // frames that confirmed it
@@ -55,6 +57,8 @@ struct PlaneBelief
   bool update(const PlaneEvidence& evidence);
   bool gone() const { return log_odds < kRemoveBelow; }
   bool established() const { return confirmations >= kEstablishedAfter; }
+  // Seen in one frame only: no later frame has confirmed it.
+  bool tentative() const { return confirmations == 0 && !gone(); }
 };
 
 }  // namespace hough_plane_detector
