@@ -48,7 +48,7 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
 {
   const float cap = static_cast<float>(params_.permanence_cap);
   // Thinning first, so a plane seen in this frame ends the frame at least 1 higher.
-  thin(cap);
+  thin(cap, frame_planes);
   // Algorithm 2: every frame plane adds one Gaussian; the peaks are seeded from the cells of
   // this frame's planes and of the map's.
   std::vector<Eigen::Vector3i> seeds;
@@ -71,11 +71,11 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   return evicted;
 }
 
-void PlaneMap::thin(float cap)
+void PlaneMap::thin(float cap, const std::vector<FramePlane>& frame_planes)
 {
   // By evidence, what is out of view keeps its state; the rest thins as in the paper.
   if (params_.forgetting == kForgetByEvidence)
-    thinByEvidence(cap);
+    thinByEvidence(cap, frame_planes);
   else
     global_.thin(static_cast<float>(params_.thinning_rate), cap);
 }
@@ -89,16 +89,25 @@ float PlaneMap::voteWeight(const FramePlane& plane) const
   // A plane of the parallel search, or one snapped to a known normal, measured only its
   // offset, so a quarter of the points is as strong.
   for (const DetectedPlane& known : planes_)
-  {
-    const double sign = known.normal.dot(plane.normal) >= 0.0 ? 1.0 : -1.0;
-    if (unsignedAngle(known.normal, plane.normal) < params_.merge_angle &&
-        std::abs(known.d - sign * plane.d) < params_.merge_distance)
-      return 1.0f;
-  }
+    if (samePlane(known, plane)) return 1.0f;
   if (params_.strong_support <= 0 || plane.support < 2.0 * params_.min_support) return 1.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
   const double points = plane.first_sight_points;
   return static_cast<float>(1.0 + std::min(1.0, points / (plane.parallel ? 0.25 * strong_support : strong_support)));
+}
+
+bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured) const
+{
+  const double sign = known.normal.dot(measured.normal) >= 0.0 ? 1.0 : -1.0;
+  return unsignedAngle(known.normal, measured.normal) < params_.merge_angle &&
+         std::abs(known.d - sign * measured.d) < params_.merge_distance;
+}
+
+bool PlaneMap::remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const
+{
+  for (const FramePlane& measured : frame_planes)
+    if (samePlane(plane, measured)) return true;
+  return false;
 }
 
 void PlaneMap::matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp)
@@ -213,7 +222,7 @@ float PlaneMap::extentFade() const
   return params_.forgetting == kForgetByEvidence ? 0.0f : static_cast<float>(params_.thinning_rate);
 }
 
-void PlaneMap::thinByEvidence(float cap)
+void PlaneMap::thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes)
 {
   // The cells around each established map plane's peak (its blur and peak window, and the
   // mirrored copy near the border) are kept as they are, a gone plane's are cleared; a plane
@@ -248,14 +257,14 @@ void PlaneMap::thinByEvidence(float cap)
         if (v > 0.0f) kept.emplace_back(Eigen::Vector3i(x, y, z), v);
       });
   }
-  // A tentative plane (no frame after its first confirmed it) that the last frame did not support
-  // loses half a vote a frame, thinning included: one view's hypothesis leaves unless seen again,
+  // A tentative plane (no frame after its first confirmed it) that this frame does not measure
+  // again loses half a vote, thinning included: one view's hypothesis leaves unless seen again,
   // as a tracker's tentative tracks do (after the established planes' cells are noted above).
   const float tentative_fade = static_cast<float>(std::max(0.0, PlaneBelief::kTentativeFade - params_.thinning_rate));
   for (const DetectedPlane& plane : planes_)
   {
     const auto belief = beliefs_.find(plane.id);
-    if (belief == beliefs_.end() || !belief->second.tentative() || plane.support >= params_.min_support) continue;
+    if (belief == beliefs_.end() || !belief->second.tentative() || remeasured(plane, frame_planes)) continue;
     forBox(plane.hough, [&](int x, int y, int z) {
       const float v = global_.value(x, y, z);
       if (v > 0.0f) global_.add(x, y, z, -std::min(v, tentative_fade));

@@ -46,7 +46,7 @@ struct PlaneBelief
   // until then it fades as in the paper, so a plane one view suggested (a pillar's tangent)
   // does not stay for good once the camera turns away.
   static constexpr int64_t kEstablishedAfter = 6;
-  // Votes a tentative plane loses per frame that does not support it (a frame's vote adds 1).
+  // Votes a tentative plane loses per frame that does not measure it again (a frame's vote adds 1).
   static constexpr double kTentativeFade = 0.5;
 
   double log_odds = kStart;

@@ -67,8 +67,12 @@ public:
 
 private:
   // Thinning (3.7); by evidence, the cells of established planes are spared and gone planes' cleared.
-  void thin(float cap);
-  void thinByEvidence(float cap);
+  void thin(float cap, const std::vector<FramePlane>& frame_planes);
+  void thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes);
+  // True when the frame's plane lies on the map's within the merge tolerances (either side).
+  bool samePlane(const DetectedPlane& known, const FramePlane& measured) const;
+  // True when one of this frame's planes lies on `plane` within the merge tolerances.
+  bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
   // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map.
   float voteWeight(const FramePlane& plane) const;
   // The space's peaks as the new plane list, ids carried over from the closest previous plane.
