@@ -28,12 +28,16 @@ namespace
 std::string fmt(const char* format, ...) __attribute__((format(printf, 1, 2)));
 std::string fmt(const char* format, ...)
 {
-  char buffer[1024];
-  va_list args;
+  // Sized by a first pass: report paragraphs outgrow any fixed buffer.
+  va_list args, again;
   va_start(args, format);
-  std::vsnprintf(buffer, sizeof(buffer), format, args);
+  va_copy(again, args);
+  const int length = std::vsnprintf(nullptr, 0, format, args);
   va_end(args);
-  return buffer;
+  std::string text(length > 0 ? static_cast<size_t>(length) : 0, '\0');
+  if (length > 0) std::vsnprintf(&text[0], text.size() + 1, format, again);
+  va_end(again);
+  return text;
 }
 
 std::string meanStd(const std::vector<double>& v, const char* number_format)
@@ -371,6 +375,7 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
                       "|---|---|---|---|---|---|---|\n";
   for (size_t v = 0; v < e.variants.size(); ++v)
     table += fmt("| %zu held-out ", e.held_out_seeds) + accuracyRow(e.variants[v], e.held_out[v]);
+  table += fmt("| %zu held-out, at C = 1 ", e.held_out_seeds) + accuracyRow(e.variants.front(), e.held_out_at_c1);
   for (size_t v = 0; v < e.variants.size(); ++v)
     table += fmt("| %zu tuning ", e.tuning_seeds) + accuracyRow(e.variants[v], e.tuning[v]);
   std::string rows;
@@ -387,17 +392,21 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
                    "scored every 3rd from frame %d as Table 3. The held-out seeds (101-120) were written down before "
                    "any threshold was chosen on these rooms and are reported only; tuning looks at seeds 901-908 "
                    "only. The rows without the parallel search and without the snap show what each of those rules "
-                   "adds. Targets on the held-out seeds (C = 0.5-2 here, not C = 1 alone): >= 95 %% detected, <= "
-                   "0.05 false planes per frame, E_angle <= 0.01 rad, E_d <= 1 cm.\n\n",
+                   "adds. The row at C = 1 renders the same held-out rooms and paths at C = 1, the condition the "
+                   "targets are stated at; the rows above it keep each room's own C. Targets on the held-out seeds: "
+                   ">= 95 %% detected, <= 0.05 false planes per frame, E_angle <= 0.01 rad, E_d <= 1 cm.\n\n",
                    e.frames, kWarmupFrames)
             << table << "\n| held-out seed | room | defaults detected | false / frame | windows detected | "
                         "false / frame |\n|---|---|---|---|---|---|\n"
             << rows << '\n';
-  const MethodStats& h = e.held_out.front();
-  report.verdict(h.detectionPercent() >= 95.0 && h.falsePerFrame() <= 0.05 && mean(h.angle) <= 0.01 && mean(h.d) <= 0.01,
-                 fmt("held-out procedural rooms (defaults): %.1f %% detected >= 95 %%, %.3f false planes per frame <= "
-                     "0.05, E_angle %.4f rad, E_d %.4f m",
-                     h.detectionPercent(), h.falsePerFrame(), mean(h.angle), mean(h.d)));
+  auto verdict = [&](const MethodStats& h, const char* which) {
+    report.verdict(h.detectionPercent() >= 95.0 && h.falsePerFrame() <= 0.05 && mean(h.angle) <= 0.01 && mean(h.d) <= 0.01,
+                   fmt("held-out procedural rooms (defaults, %s): %.1f %% detected >= 95 %%, %.3f false planes per "
+                       "frame <= 0.05, E_angle %.4f rad, E_d %.4f m",
+                       which, h.detectionPercent(), h.falsePerFrame(), mean(h.angle), mean(h.d)));
+  };
+  verdict(e.held_out.front(), "each room's C, 0.5-2");
+  verdict(e.held_out_at_c1, "C = 1");
 }
 
 // ../shared/data/kinect-real: a still camera, no ground truth; time and planes found.

@@ -119,6 +119,7 @@ struct RandomSceneExperiment
   int frames = 0;
   std::vector<std::string> variants;           // the defaults first, the paper's windows last
   std::vector<MethodStats> held_out, tuning;   // by variant
+  MethodStats held_out_at_c1;                  // the defaults on the held-out rooms rendered at C = 1
   size_t held_out_seeds = 0, tuning_seeds = 0;
   std::vector<HeldOutRoom> rooms;              // the held-out seeds one by one
 };
