@@ -66,7 +66,8 @@ public:
   static std::string withChecksum(const std::string& bytes);
 
 private:
-  // Thinning (3.7); by evidence, the cells of established planes are spared and gone planes' cleared.
+  // Thinning (3.7); by evidence, the cells of established planes are spared, gone planes' cleared, and
+  // tentative planes none of `frame_planes` measures again fade by PlaneBelief::kTentativeFade.
   void thin(float cap, const std::vector<FramePlane>& frame_planes);
   void thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes);
   // True when the frame's plane lies on the map's within the merge tolerances (either side).
