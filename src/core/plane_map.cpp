@@ -87,12 +87,15 @@ float PlaneMap::voteWeight(const FramePlane& plane) const
   // (thinning and permanence keep their pace). Noisier sensors need more points for the same
   // precision: the bar rises with sensor_noise^2, and near points count more (detector_params.h).
   // A plane of the parallel search, or one snapped to a known normal, measured only its
-  // offset, so a quarter of the points is as strong.
+  // offset, so a quarter of the points is as strong. One of under 2 min_support points is too
+  // small for the curvature tests: it waits for a second frame, unless it is parallel and its
+  // weighted points reach the full bar (a box top near the sensor).
   for (const DetectedPlane& known : planes_)
     if (samePlane(known, plane)) return 1.0f;
-  if (params_.strong_support <= 0 || plane.support < 2.0 * params_.min_support) return 1.0f;
+  if (params_.strong_support <= 0) return 1.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
   const double points = plane.first_sight_points;
+  if (plane.support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
   return static_cast<float>(1.0 + std::min(1.0, points / (plane.parallel ? 0.25 * strong_support : strong_support)));
 }
 

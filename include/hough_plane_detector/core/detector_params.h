@@ -72,7 +72,8 @@ struct DetectorParams
   // first sight; planes in the map, and all with 0, add 1 (the paper). A point nearer than
   // kStrongSupportDepth counts (sigma there / sigma at its depth)^2: near the sensor one
   // frame's tests see the folds and bends noise hides farther away. A plane of under
-  // 2 min_support points always needs a second frame (too small for the curvature tests).
+  // 2 min_support points needs a second frame (too small for the curvature tests), unless it is
+  // parallel to a known plane and its weighted points reach strong_support itself.
   int strong_support = 16000;
   // Amount every global cell loses per frame (paper 3.7: 0.01 - 0.1).
   double thinning_rate = 0.05;
