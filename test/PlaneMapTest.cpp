@@ -80,16 +80,16 @@ TEST(PlaneMap, NearPointsCountByTheirPrecisionButASmallPatchWaits)
 TEST(PlaneMap, ASmallPatchParallelToAKnownPlaneIsReportedAtFirstSightOnlyWithTheFullBar)
 {
   // A box top beside the table: 1,400 points at 0.6 m. Its normal is the known one, only its
-  // offset is measured; being too small for the curvature tests it earns no discount (a strip of
-  // a pillar a wall's normal fits): its precision-weighted points must reach strong_support.
+  // offset is measured. Too small for the curvature tests, it earns no discount (a pillar's strip
+  // fits a wall's normal too): its precision-weighted points must reach strong_support itself.
   const double small_support = 1400;
   Map near;
   FramePlane top = near.plane(kFloor, 1.0, small_support, near.params.strong_support);
   top.parallel = true;
   near.frame({top}, 0.0);
   EXPECT_EQ(near.map.planes().size(), 1u);
-  // With its weighted points just under the bar (farther away) it waits for a second frame, though a
-  // parallel plane of 2 min_support points needs only a quarter of the bar.
+  // With its weighted points just under the bar (farther away) it waits for a second frame,
+  // though a parallel plane of 2 min_support points needs only a quarter of the bar.
   Map far;
   FramePlane strip = far.plane(kFloor, 1.0, small_support, 0.9 * far.params.strong_support);
   strip.parallel = true;
