@@ -5,6 +5,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "hough_plane_detector/core/symmetric_eigen.h"
+
 namespace hough_plane_detector
 {
 
@@ -43,7 +45,6 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
 {
   const int bx_count = grid.blocksX(), count = grid.blocksX() * grid.blocksY();
   info.assign(count, BlockInfo());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   const bool noise_aware = noise.enabled();
   for (int b = 0; b < count; ++b)
   {
@@ -67,13 +68,13 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
     const double block_sigma = std::max(kMinBlockSigma, sigma);
     i.region_residual = 3.0 * std::sqrt(block_sigma * block_sigma / block.count + step * step / 12.0 + systematic * systematic);
     if (!params.region_growing) continue;  // the windows' fit needs no block normals
-    solver.computeDirect(i.covariance);
-    i.normal = solver.eigenvectors().col(0);
+    const SmallestEigenpair eigen = smallestEigenpair(i.covariance);
+    i.normal = eigen.vector;
     if (i.normal.dot(i.centroid) > 0.0) i.normal = -i.normal;
     // Flat: thinner along its normal than three sigmas of the sensor's noise (an edge or a
     // depth jump inside the block is thicker). Its normal is then good to sigma over its
     // narrower half-width, per point.
-    const Eigen::Vector3d eigenvalues = solver.eigenvalues().cwiseMax(0.0);
+    const Eigen::Vector3d eigenvalues = eigen.values.cwiseMax(0.0);
     i.planar = block.count >= 8 && (noise_aware ? eigenvalues(0) <= 9.0 * block_sigma * block_sigma : eigenvalues(0) <= i.thickness_limit);
     // Where the block is as thick as half its width (noise far from a Kinect) its smallest
     // eigenvector may lie in the surface: such a block is judged by its centroid alone. Both
@@ -82,6 +83,7 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
     const bool normal_informative = eigenvalues(0) < kMaxThicknessRatio * eigenvalues(1);
     i.normal_tolerance = normal_informative ? std::min(kMaxNormalTolerance, std::max(params.support_angle, 3.0 * normal_sigma))
                                             : M_PI / 2;
+    i.normal_tolerance_cosine = std::cos(i.normal_tolerance);
   }
 }
 
@@ -95,7 +97,7 @@ bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double
 {
   const BlockInfo& i = info_[block];
   if (!i.planar) return false;
-  if (std::abs(i.normal.dot(normal)) < std::cos(i.normal_tolerance)) return false;
+  if (std::abs(i.normal.dot(normal)) < i.normal_tolerance_cosine) return false;
   // Rays that graze a plane move along it with their depth error, so any surface they hit
   // lies "on" it: a plane seen edge-on cannot be tested, and no block joins it that way.
   if (std::abs(normal.dot(i.centroid.normalized())) < kMinRaySine) return false;

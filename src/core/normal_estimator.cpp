@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
+#include "hough_plane_detector/core/symmetric_eigen.h"
 
 namespace hough_plane_detector
 {
@@ -243,7 +243,6 @@ bool NormalEstimator::measureWindow(int wx, int wy, int k, const NormalEstimator
   // Far from a Kinect a window can be as thick (noise) as it is wide, and its normal is then
   // mostly noise: measure it again over a window twice, then four times, as wide around it.
   // The widest planar measurement wins; a wider window that crosses an edge keeps the last.
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   bool planar = false;
   for (int scale = 1; scale <= config.max_window_scale; scale *= 2)
   {
@@ -257,12 +256,12 @@ bool NormalEstimator::measureWindow(int wx, int wy, int k, const NormalEstimator
     const double sigma = config.noise.sigma(centre.z());
     const Eigen::Vector3d ray = centre / centre.z();  // a depth error e moves a point by e * ray
     const Eigen::Matrix3d covariance = m.covariance();
-    solver.computeDirect(covariance);
-    const double ray_along_normal = ray.dot(solver.eigenvectors().col(0));
-    const double noise_variance = std::min(sigma * sigma, std::max(0.0, solver.eigenvalues()(0)) /
+    SmallestEigenpair eigen = smallestEigenpair(covariance);
+    const double ray_along_normal = ray.dot(eigen.vector);
+    const double noise_variance = std::min(sigma * sigma, std::max(0.0, eigen.values(0)) /
                                                                std::max(1e-9, ray_along_normal * ray_along_normal));
-    if (noise_variance > 0.0) solver.computeDirect(covariance - noise_variance * ray * ray.transpose());
-    const Eigen::Vector3d eigenvalues = solver.eigenvalues();
+    if (noise_variance > 0.0) eigen = smallestEigenpair(covariance - noise_variance * ray * ray.transpose());
+    const Eigen::Vector3d eigenvalues = eigen.values;
     const double trace = eigenvalues.sum();
     if (!(trace > 0.0)) break;
     // Planar when flat relative to its size, or no rougher than the sensor's noise at that
@@ -270,7 +269,7 @@ bool NormalEstimator::measureWindow(int wx, int wy, int k, const NormalEstimator
     const double noise = 3.0 * sigma;
     if (eigenvalues(0) > config.max_curvature * trace && eigenvalues(0) > noise * noise) continue;
     planar = true;
-    normal = solver.eigenvectors().col(0);
+    normal = eigen.vector;
     mean = centre;
     if (eigenvalues(0) <= kMaxThicknessRatio * eigenvalues(1)) break;
   }

@@ -28,6 +28,7 @@ struct BlockInfo
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // of its own points, toward the sensor
   double normal_tolerance = 0;   // largest angle to a region's normal its noise explains (rad)
+  double normal_tolerance_cosine = 1;  // its cosine, tested for every block a region meets
   double centroid_variance = 0;  // expected scatter of the centroid about its true plane
   double tight_residual = 0;     // farthest a centroid may lie from a fitted plane
   double region_residual = 0;    // farthest it may lie from its region's plane: noise and systematic error
