@@ -13,6 +13,32 @@ namespace hough_plane_detector
 namespace
 {
 constexpr double kMinSnapInlierShare = 0.8;  // snapping: points that must lie on the parallel plane
+
+// The smallest value whose own and smaller values' weights reach half of `total` (their sum),
+// by selection rather than a sort (it runs for every snap candidate); reorders `values`.
+double weightedMedian(std::vector<std::pair<double, double>>& values, double total)
+{
+  auto first = values.begin(), last = values.end();
+  double below = 0.0;  // weight of the values before `first`, all smaller
+  while (last - first > 1)
+  {
+    const auto middle = first + (last - first) / 2;
+    std::nth_element(first, middle, last);
+    double lower = below;
+    for (auto it = first; it != middle; ++it) lower += it->second;
+    if (lower >= 0.5 * total)
+      last = middle;
+    else if (lower + middle->second >= 0.5 * total)
+      return middle->first;
+    else
+    {
+      below = lower + middle->second;
+      first = middle + 1;
+    }
+  }
+  if (first != values.end() && below + first->second >= 0.5 * total) return first->first;
+  return std::max_element(values.begin(), values.end())->first;
+}
 }  // namespace
 
 const char* toString(CandidateVerdict verdict)
@@ -304,14 +330,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
     offsets.emplace_back(-n_cam.dot(frame_.blocks[b].centroid), points(b));
     total += points(b);
   }
-  std::sort(offsets.begin(), offsets.end());
-  double median = offsets.back().first, below = 0.0;
-  for (const auto& offset : offsets)
-    if ((below += offset.second) >= 0.5 * total)
-    {
-      median = offset.first;
-      break;
-    }
+  const double median = weightedMedian(offsets, total);
   std::vector<int> inliers;
   double inlier_points = 0.0, weight_sum = 0.0, weighted_d = 0.0;
   for (int b : blocks)
