@@ -13,32 +13,6 @@ namespace hough_plane_detector
 namespace
 {
 constexpr double kMinSnapInlierShare = 0.8;  // snapping: points that must lie on the parallel plane
-
-// The smallest value whose own and smaller values' weights reach half of `total` (their sum),
-// by selection rather than a sort (it runs for every snap candidate); reorders `values`.
-double weightedMedian(std::vector<std::pair<double, double>>& values, double total)
-{
-  auto first = values.begin(), last = values.end();
-  double below = 0.0;  // weight of the values before `first`, all smaller
-  while (last - first > 1)
-  {
-    const auto middle = first + (last - first) / 2;
-    std::nth_element(first, middle, last);
-    double lower = below;
-    for (auto it = first; it != middle; ++it) lower += it->second;
-    if (lower >= 0.5 * total)
-      last = middle;
-    else if (lower + middle->second >= 0.5 * total)
-      return middle->first;
-    else
-    {
-      below = lower + middle->second;
-      first = middle + 1;
-    }
-  }
-  if (first != values.end() && below + first->second >= 0.5 * total) return first->first;
-  return std::max_element(values.begin(), values.end())->first;
-}
 }  // namespace
 
 const char* toString(CandidateVerdict verdict)

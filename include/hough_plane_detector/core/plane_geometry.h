@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -20,6 +22,34 @@ inline Eigen::Vector3i nearestCell(const Eigen::Vector3d& cell)
 {
   return Eigen::Vector3i(static_cast<int>(std::lround(cell.x())), static_cast<int>(std::lround(cell.y())),
                          static_cast<int>(std::lround(cell.z())));
+}
+
+// The smallest value whose own and smaller values' weights reach half of `total` (their sum):
+// by selection rather than a sort, as the snap runs it for every candidate. Reorders `values`;
+// NaN when there are none.
+inline double weightedMedian(std::vector<std::pair<double, double>>& values, double total)
+{
+  if (values.empty()) return std::nan("");
+  auto first = values.begin(), last = values.end();
+  double below = 0.0;  // weight of the values before `first`, all smaller
+  while (last - first > 1)
+  {
+    const auto middle = first + (last - first) / 2;
+    std::nth_element(first, middle, last);
+    double lower = below;
+    for (auto it = first; it != middle; ++it) lower += it->second;
+    if (lower >= 0.5 * total)
+      last = middle;
+    else if (lower + middle->second >= 0.5 * total)
+      return middle->first;
+    else
+    {
+      below = lower + middle->second;
+      first = middle + 1;
+    }
+  }
+  if (first != values.end() && below + first->second >= 0.5 * total) return first->first;
+  return std::max_element(values.begin(), values.end())->first;
 }
 
 }  // namespace hough_plane_detector
