@@ -145,7 +145,18 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
   hessian << 2.0 * quadric(3), quadric(4), quadric(4), 2.0 * quadric(5);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> curvatures;
   curvatures.computeDirect(hessian);
-  return curvatures.eigenvalues().cwiseAbs().maxCoeff() > kMaxPlaneCurvature;
+  for (int k = 0; k < 2; ++k)
+  {
+    const double curvature = std::abs(curvatures.eigenvalues()(k));
+    if (curvature <= kMaxPlaneCurvature) continue;
+    // Its sag over the region's width along that axis (sqrt(12 var) for an even spread).
+    const Eigen::Vector3d axis = curvatures.eigenvectors()(0, k) * u + curvatures.eigenvectors()(1, k) * v;
+    double variance = 0.0;
+    for (int b : blocks) variance += std::pow(axis.dot(info_[b].centroid - mean), 2);
+    variance /= blocks.size();
+    if (curvature * 12.0 * variance / 8.0 > kMaxPlaneSag) return true;
+  }
+  return false;
 }
 
 bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
@@ -204,7 +215,10 @@ bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen:
     }
     const double tilt = std::acos(std::min(1.0, half_normal[0].dot(half_normal[1])));
     const double separation = (where[1] - where[0]).norm();
-    if (tilt > 3.0 * std::sqrt(error_variance) && tilt > kMaxPlaneCurvature * separation) return true;
+    // The halves' centres lie half the width apart, so the sag is tilt * separation / 2.
+    if (tilt > 3.0 * std::sqrt(error_variance) && tilt > kMaxPlaneCurvature * separation &&
+        tilt * separation / 2.0 > kMaxPlaneSag)
+      return true;
   }
   return false;
 }

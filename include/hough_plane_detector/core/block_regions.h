@@ -16,8 +16,13 @@ namespace hough_plane_detector
 {
 
 // A surface bending more than this (1/m: radius 0.5 m) is not a plane; cardboard faces and
-// warped walls bend far less, pillars, balls and cans more.
+// warped walls bend far less, pillars, balls and cans more...
 constexpr double kMaxPlaneCurvature = 2.0;
+// ...unless the bend moves no point of the region farther than this (m) from its plane: finer
+// than a depth sensor resolves (a Kinect's disparity step is 0.7 mm at 0.5 m), as a box lid
+// doming 1 mm over 5 cm at 0.7 m (curvature 3/m). A can of 3.3 cm radius passes only as a
+// strip under 1.6 cm wide.
+constexpr double kMaxPlaneSag = 0.001;
 
 // One block of the last frame, camera frame, with the noise limits the tests use.
 struct BlockInfo
@@ -94,10 +99,11 @@ public:
   bool seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // True when the block centroids bend away from the plane: a quadric fit explains them
   // significantly better (chi^2 drop over 3 degrees of freedom, p < 0.001) and its larger
-  // principal curvature exceeds what a plane may have (a pillar's, a ball's or a can's side).
+  // principal curvature exceeds what a plane may have (a pillar's, a ball's or a can's side)
+  // with a sag over the region's width beyond kMaxPlaneSag.
   bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
   // True when the blocks' own normals turn across the region, significantly beyond their
-  // measured scatter and by more than a plane's curvature may be (a pillar's or can's side).
+  // measured scatter and by more than a plane's curvature and sag may be (a pillar's or can's side).
   bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // Weighted least-squares plane of the blocks' centroids; false when they fix no plane.
   bool fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
