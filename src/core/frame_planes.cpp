@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
@@ -232,6 +234,65 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     if (frame_.block_claim[b] || tried[b]) continue;
     const BlockInfo& info = frame_.blocks[b];
     consider({b}, info.normal, -info.normal.dot(info.centroid), 0.0);
+  }
+  mergeTouchingRegions(grower, planes);
+}
+
+void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const
+{
+  // Two touching regions whose normals the map would keep apart are one plane when their union
+  // passes the region tests and each part lies on the union's plane within its noise: a box
+  // face bowed or warped by a few degrees, grown as two regions, is otherwise reported twice.
+  // Folds of more than two merge_angle stay apart, as halvesAgree keeps them; a plane with a
+  // known normal (snapped) measured only its offset and is left as it is.
+  const int bx_count = frame_.blocksX(), by_count = frame_.blocksY();
+  std::vector<int> owner(frame_.blocks.size());
+  for (bool merged = true; merged;)
+  {
+    merged = false;
+    std::fill(owner.begin(), owner.end(), -1);
+    for (size_t p = 0; p < planes.size(); ++p)
+      for (int b : planes[p].blocks) owner[b] = static_cast<int>(p);
+    std::set<std::pair<int, int>> touching;
+    auto touch = [&](int a, int b) {
+      if (owner[a] >= 0 && owner[b] >= 0 && owner[a] != owner[b])
+        touching.emplace(std::min(owner[a], owner[b]), std::max(owner[a], owner[b]));
+    };
+    for (int y = 0; y < by_count; ++y)
+      for (int x = 0; x < bx_count; ++x)
+      {
+        const int b = y * bx_count + x;
+        if (x + 1 < bx_count) touch(b, b + 1);
+        if (y + 1 < by_count) touch(b, b + bx_count);
+      }
+    for (const auto& pair : touching)
+    {
+      FramePlane& kept = planes[pair.first];
+      const FramePlane& other = planes[pair.second];
+      if (kept.parallel || other.parallel || unsignedAngle(kept.normal, other.normal) > 2.0 * params_.merge_angle)
+        continue;
+      PlaneRegion region;
+      region.blocks = kept.blocks;
+      region.blocks.insert(region.blocks.end(), other.blocks.begin(), other.blocks.end());
+      for (int b : region.blocks) region.points += frame_.points(b);
+      region.normal = frame_.normalInCamera(kept.normal);
+      region.d = frame_.dInCamera(kept.normal, kept.d);
+      PointMoments moments;
+      if (testRegion(grower, region, moments) != CandidateVerdict::kAccepted || !normalDetermined(region.blocks) ||
+          tests_.centroidChi2(region.normal, region.d, kept.blocks) > kMaxMeanCentroidChi2 ||
+          tests_.centroidChi2(region.normal, region.d, other.blocks) > kMaxMeanCentroidChi2)
+        continue;
+      kept.normal = frame_.camera_to_world.linear() * region.normal;
+      kept.d = region.d - kept.normal.dot(frame_.camera_to_world.translation());
+      kept.hough = param_.toHough(kept.normal, kept.d);
+      kept.value = std::max(kept.value, other.value);
+      kept.support = moments.count;
+      kept.first_sight_points = tests_.firstSightPoints(region.blocks);
+      kept.blocks = region.blocks;
+      planes.erase(planes.begin() + pair.second);
+      merged = true;
+      break;  // indices moved: list the touching pairs again
+    }
   }
 }
 

@@ -90,6 +90,8 @@ private:
                                    PointMoments& weighted);
   // The planarity tests of a grown region, in order; the flat components' moments in `moments`.
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
+  // Joins touching regions of this frame that the region tests accept as one plane.
+  void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const;
   // True when the blocks fix the normal within merge_angle / 3 (one sigma).
   bool normalDetermined(const std::vector<int>& blocks) const;
   // The normal of the map's or this frame's planes closest to `normal` within snap_angle, or nullptr.
