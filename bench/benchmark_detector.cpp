@@ -60,9 +60,6 @@ MethodStats benchStages(const SceneRenderer& renderer, const std::vector<Rendere
   return ours;
 }
 
-// What the options cost on the same frames: the paper's windows instead of block regions, and
-// the paper's thinning instead of forgetting by evidence (its check of the map's planes against
-// each frame); and fitting the projection to each cloud.
 // The normals' 3 x 3 eigen-decompositions (one per 8 x 8 block and one or two per window):
 // Eigen's closed form against smallestEigenpair, on the blocks of the rendered frames.
 void benchEigenSolvers(const std::vector<RenderedFrame>& rendered)
@@ -114,6 +111,9 @@ void benchEigenSolvers(const std::vector<RenderedFrame>& rendered)
               scatters.size(), closed_form_ns, ours_ns, worst_angle);
 }
 
+// What the options cost on the same frames: the paper's windows instead of block regions, and
+// the paper's thinning instead of forgetting by evidence (its check of the map's planes against
+// each frame); fitting the projection to each cloud; the normals' eigen-decompositions.
 void benchVariants(const std::vector<RenderedFrame>& rendered)
 {
   const int frames = static_cast<int>(rendered.size());
