@@ -49,8 +49,8 @@ PointMoments FramePlaneFitter::collectPlaneBlocks(const Eigen::Vector3d& normal,
   block_mark_.resize(static_cast<size_t>(bx_count) * frame_.normals.blocksY(), 0);
   ++mark_generation_;
   // The plane in the camera frame, to test block centroids without transforming blocks.
-  const Eigen::Vector3d n_cam = frame_.camera_to_world.linear().transpose() * normal;
-  const double d_cam = d + normal.dot(frame_.camera_to_world.translation());
+  const Eigen::Vector3d n_cam = frame_.normalInCamera(normal);
+  const double d_cam = frame_.dInCamera(normal, d);
   PointMoments moments;
   blocks.clear();
   for (int s : windows)
@@ -184,8 +184,8 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
     PointMoments moments;
     CandidateVerdict verdict = testRegion(grower, region, moments);
-    Eigen::Vector3d normal = frame_.camera_to_world.linear() * region.normal;
-    double d = region.d - normal.dot(frame_.camera_to_world.translation());
+    Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
+    double d = frame_.dInWorld(normal, region.d);
     const bool snapped =
         verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, map_planes, planes);
     if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(region.blocks))
@@ -197,22 +197,13 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
       for (int b : region.blocks) frame_.block_claim[b] = 1;
     if (verdict != CandidateVerdict::kAccepted) return;
     for (int b : region.blocks) frame_.block_claim[b] = 1;
-    FramePlane refined;
-    refined.normal = normal;
-    refined.d = d;
-    refined.hough = param_.toHough(normal, d);
-    refined.value = peak_value;
-    refined.support = moments.count;
-    refined.parallel = snapped;
-    refined.first_sight_points = tests_.firstSightPoints(region.blocks);
-    refined.blocks = region.blocks;
-    planes.push_back(refined);
+    planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks));
   };
   constexpr size_t kMinSeedBlocks = 2;
   for (const HoughPeak& peak : peaks)
   {
     const Eigen::Vector3d n_cam = world_to_camera * peak.normal;
-    const double d_cam = peak.d + peak.normal.dot(frame_.camera_to_world.translation());
+    const double d_cam = frame_.dInCamera(peak.normal, peak.d);
     for (const std::vector<int>& seed : grower.seedComponents(n_cam, d_cam, frame_.block_claim))
     {
       if (seed.size() < kMinSeedBlocks) break;
@@ -236,6 +227,21 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     consider({b}, info.normal, -info.normal.dot(info.centroid), 0.0);
   }
   mergeTouchingRegions(grower, planes);
+}
+
+FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d, double value, double support,
+                                         bool parallel, const std::vector<int>& blocks) const
+{
+  FramePlane plane;
+  plane.normal = normal;
+  plane.d = d;
+  plane.hough = param_.toHough(normal, d);
+  plane.value = value;
+  plane.support = support;
+  plane.parallel = parallel;
+  plane.first_sight_points = tests_.firstSightPoints(blocks);
+  plane.blocks = blocks;
+  return plane;
 }
 
 void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const
@@ -282,13 +288,9 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
           tests_.centroidChi2(region.normal, region.d, kept.blocks) > kMaxMeanCentroidChi2 ||
           tests_.centroidChi2(region.normal, region.d, other.blocks) > kMaxMeanCentroidChi2)
         continue;
-      kept.normal = frame_.camera_to_world.linear() * region.normal;
-      kept.d = region.d - kept.normal.dot(frame_.camera_to_world.translation());
-      kept.hough = param_.toHough(kept.normal, kept.d);
-      kept.value = std::max(kept.value, other.value);
-      kept.support = moments.count;
-      kept.first_sight_points = tests_.firstSightPoints(region.blocks);
-      kept.blocks = region.blocks;
+      const Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
+      kept = regionPlane(normal, frame_.dInWorld(normal, region.d), std::max(kept.value, other.value), moments.count,
+                         false, region.blocks);
       planes.erase(planes.begin() + pair.second);
       merged = true;
       break;  // indices moved: list the touching pairs again
@@ -353,7 +355,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   const Eigen::Vector3d* closest = closestKnownNormal(normal, map_planes, planes);
   if (!closest || blocks.empty()) return false;
   const Eigen::Vector3d known = closest->dot(normal) >= 0.0 ? *closest : Eigen::Vector3d(-*closest);
-  const Eigen::Vector3d n_cam = frame_.camera_to_world.linear().transpose() * known;
+  const Eigen::Vector3d n_cam = frame_.normalInCamera(known);
   // The offset most points agree on (a median: the leaning blocks are outliers), then the
   // blocks within three of their sigmas of it.
   const int bx_count = frame_.normals.blocksX();
@@ -387,7 +389,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
   if (!tests_.explainedByNormal(n_cam, inliers)) return false;
   normal = known;
-  d = d_cam - known.dot(frame_.camera_to_world.translation());
+  d = frame_.dInWorld(known, d_cam);
   return true;
 }
 

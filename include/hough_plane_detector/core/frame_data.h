@@ -38,6 +38,9 @@ struct FrameData
   // A world plane (normal, d) in the camera frame, where the blocks are.
   Eigen::Vector3d normalInCamera(const Eigen::Vector3d& normal) const { return camera_to_world.linear().transpose() * normal; }
   double dInCamera(const Eigen::Vector3d& normal, double d) const { return d + normal.dot(camera_to_world.translation()); }
+  // And back: a camera-frame normal in the world frame, and the world d of that world normal.
+  Eigen::Vector3d normalInWorld(const Eigen::Vector3d& n_cam) const { return camera_to_world.linear() * n_cam; }
+  double dInWorld(const Eigen::Vector3d& normal, double d_cam) const { return d_cam - normal.dot(camera_to_world.translation()); }
 };
 
 }  // namespace hough_plane_detector

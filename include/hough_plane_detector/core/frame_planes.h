@@ -90,6 +90,9 @@ private:
                                    PointMoments& weighted);
   // The planarity tests of a grown region, in order; the flat components' moments in `moments`.
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
+  // A region's accepted plane (world frame) as the map receives it.
+  FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
+                         const std::vector<int>& blocks) const;
   // Joins touching regions of this frame that the region tests accept as one plane.
   void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const;
   // True when the blocks fix the normal within merge_angle / 3 (one sigma).
