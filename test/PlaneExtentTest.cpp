@@ -1,6 +1,7 @@
 // Extents as shapes: each connected region's outline (concave where the region is) and holes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "hough_plane_detector/core/plane_extent.h"
@@ -81,4 +82,28 @@ TEST(PlaneExtent, TwoTablesAreTwoShapesAndASparseWallIsOne)
   ASSERT_EQ(one.size(), 1u);
   EXPECT_TRUE(one[0].holes.empty());
   EXPECT_EQ(one[0].boundary.size(), 4u);
+}
+
+TEST(PlaneExtent, ASweptExtentKeepsItsLiveCellsAndAddsToTheRightOnes)
+{
+  // Two cells that fade out, then one marked again in the frame of the sweep: the sweep moves
+  // the live cell within the extent's storage, and later marks must still find it.
+  PlaneExtent extent;
+  const float fade = 0.05f;
+  const Eigen::Vector3d faded_a(0.025, 0.025, 0.0), faded_b(1.025, 0.025, 0.0), live(2.025, 0.025, 0.0);
+  for (const Eigen::Vector3d& p : {faded_a, faded_b, live}) extent.add(p, kUp, 0.0, 0, fade);
+  extent.add(live, kUp, 0.0, 30, fade);  // 1 - 30 x 0.05 < 0: restarts at 1
+  extent.sweep(30, fade);
+  ASSERT_EQ(extent.cellCount(), 1u);
+  extent.add(live, kUp, 0.0, 31, fade);
+  extent.add(Eigen::Vector3d(3.025, 0.025, 0.0), kUp, 0.0, 31, fade);
+  extent.sweep(31, fade);
+  // cells() orders by the extent's own in-plane axes: tell the two apart by their weights.
+  auto cells = extent.cells();
+  ASSERT_EQ(cells.size(), 2u);
+  std::sort(cells.begin(), cells.end(), [](const auto& a, const auto& b) { return a.second.weight > b.second.weight; });
+  EXPECT_NEAR(cells[0].second.weight, 1.0f - fade + 1.0f, 1e-6);  // the live cell, marked three times
+  EXPECT_NEAR(cells[1].second.weight, 1.0f, 1e-6);
+  EXPECT_EQ(cells[0].second.seen, 31);
+  EXPECT_EQ(cells[1].second.seen, 31);
 }

@@ -33,24 +33,40 @@ void PlaneExtent::add(const Eigen::Vector3d& world_point, const Eigen::Vector3d&
   const Eigen::Vector2d point = basis_->project(world_point);
   const int32_t x = static_cast<int32_t>(std::floor(point.x() / kCellSize));
   const int32_t y = static_cast<int32_t>(std::floor(point.y() / kCellSize));
-  if (cells_.size() >= kMaxCells && cells_.find(key(x, y)) == cells_.end()) return;  // bounded memory
-  const auto inserted = cells_.try_emplace(key(x, y), Cell{1.0f, frame});
-  if (inserted.second) return;
-  const auto it = inserted.first;
+  const uint64_t k = key(x, y);
+  const auto found = index_.find(k);
+  if (found == index_.end())
+  {
+    if (cells_.size() >= kMaxCells) return;  // bounded memory
+    index_.emplace(k, static_cast<uint32_t>(cells_.size()));
+    cells_.emplace_back(k, Cell{1.0f, frame});
+    return;
+  }
+  Cell& cell = cells_[found->second].second;
   // Fading is applied lazily: a cell's weight is brought up to date when it is touched.
-  it->second.weight = std::min(kMaxWeight, std::max(0.0f, weightAt(it->second, frame, fade)) + 1.0f);
-  it->second.seen = frame;
+  cell.weight = std::min(kMaxWeight, std::max(0.0f, weightAt(cell, frame, fade)) + 1.0f);
+  cell.seen = frame;
 }
 
 void PlaneExtent::sweep(int64_t frame, float fade)
 {
-  for (auto it = cells_.begin(); it != cells_.end();)
+  // Compacted in order; the cells that moved take their new positions in the index.
+  size_t kept = 0;
+  for (size_t i = 0; i < cells_.size(); ++i)
   {
-    if (weightAt(it->second, frame, fade) <= 0.0f)
-      it = cells_.erase(it);
-    else
-      ++it;
+    if (weightAt(cells_[i].second, frame, fade) <= 0.0f)
+    {
+      index_.erase(cells_[i].first);
+      continue;
+    }
+    if (kept != i)
+    {
+      cells_[kept] = cells_[i];
+      index_[cells_[kept].first] = static_cast<uint32_t>(kept);
+    }
+    ++kept;
   }
+  cells_.resize(kept);
 }
 
 std::vector<Eigen::Vector3d> PlaneExtent::hull(int64_t frame, float fade) const
@@ -408,7 +424,12 @@ std::vector<std::pair<std::pair<int32_t, int32_t>, PlaneExtent::Cell>> PlaneExte
 
 void PlaneExtent::setCell(int32_t x, int32_t y, const Cell& cell)
 {
-  cells_[key(x, y)] = cell;
+  const uint64_t k = key(x, y);
+  const auto inserted = index_.emplace(k, static_cast<uint32_t>(cells_.size()));
+  if (inserted.second)
+    cells_.emplace_back(k, cell);
+  else
+    cells_[inserted.first->second].second = cell;
 }
 
 }  // namespace hough_plane_detector

@@ -72,7 +72,7 @@ public:
   void forEachLiveCell(int64_t frame, float fade_per_frame, int every, F f) const
   {
     if (!basis_) return;
-    for (const auto& cell : cells_)
+    for (const auto& cell : cells_)  // a plain array: no hash-bucket chasing (the evidence check's cost)
     {
       const int32_t x = static_cast<int32_t>(cell.first >> 32), y = static_cast<int32_t>(cell.first & 0xffffffffu);
       if (x % every != 0 || y % every != 0) continue;
@@ -103,7 +103,10 @@ private:
   // kMinRegionCells cells.
   std::vector<std::vector<std::pair<int32_t, int32_t>>> connectedRegions(int64_t frame, float fade) const;
   std::vector<PlaneOutline> outlinesOf(const std::vector<std::pair<int32_t, int32_t>>& region) const;
-  std::unordered_map<uint64_t, Cell> cells_;
+  // The cells as (key, cell) in one array, which every pass over the extent walks in order, and
+  // each key's position in it for the per-block look-up of add().
+  std::vector<std::pair<uint64_t, Cell>> cells_;
+  std::unordered_map<uint64_t, uint32_t> index_;
   std::shared_ptr<const PlaneBasis> basis_;
 };
 
