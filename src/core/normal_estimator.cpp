@@ -8,20 +8,6 @@
 namespace hough_plane_detector
 {
 
-void PointMoments::add(const PointMoments& o)
-{
-  count += o.count;
-  sum += o.sum;
-  xx += o.xx; xy += o.xy; xz += o.xz; yy += o.yy; yz += o.yz; zz += o.zz;
-}
-
-void PointMoments::subtract(const PointMoments& o)
-{
-  count -= o.count;
-  sum -= o.sum;
-  xx -= o.xx; xy -= o.xy; xz -= o.xz; yy -= o.yy; yz -= o.yz; zz -= o.zz;
-}
-
 void PointMoments::scale(double w)
 {
   count *= w;

@@ -20,8 +20,19 @@ struct PointMoments
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
 
-  void add(const PointMoments& o);
-  void subtract(const PointMoments& o);
+  // Inline: region growing and the windows' summed-area table call these per block.
+  void add(const PointMoments& o)
+  {
+    count += o.count;
+    sum += o.sum;
+    xx += o.xx; xy += o.xy; xz += o.xz; yy += o.yy; yz += o.yz; zz += o.zz;
+  }
+  void subtract(const PointMoments& o)
+  {
+    count -= o.count;
+    sum -= o.sum;
+    xx -= o.xx; xy -= o.xy; xz -= o.xz; yy -= o.yy; yz -= o.yz; zz -= o.zz;
+  }
   // Weights every point by w (mean and covariance unchanged, count becomes a weight sum).
   void scale(double w);
   Eigen::Vector3d mean() const { return sum / count; }
