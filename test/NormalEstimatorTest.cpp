@@ -114,3 +114,55 @@ TEST(NormalEstimator, MomentsTransformLikeThePoints)
   EXPECT_NEAR((moved.covariance() - moved_direct.covariance()).norm(), 0.0, 1e-12);
 }
 
+
+TEST(NormalEstimator, BlockMomentsDoNotDependOnThePointLayout)
+{
+  // Packed x y z (12 bytes), padded x y z _ (16 bytes) and x _ y _ z _ (24 bytes, read field by
+  // field) are summed by different loops; with holes, a NaN in x alone and an Inf in z alone,
+  // every block's moments must agree to float rounding.
+  const Eigen::Isometry3d pose = lookAt({0.2, 0.3, 1.0}, {3.0, 1.0, 0.6});
+  RenderedFrame frame = renderWall(pose, 1.0);
+  const int pixels = frame.width * frame.height;
+  for (int i = 0; i < pixels; i += 97) frame.xyz[3 * i] = std::numeric_limits<float>::quiet_NaN();
+  for (int i = 5; i < pixels; i += 89) frame.xyz[3 * i + 2] = std::numeric_limits<float>::infinity();
+  frame.xyz[3 * (pixels - 1)] = 0.5f;  // the cloud's last point valid: read to its very end
+  std::vector<float> padded(4 * pixels, 7.0f), spread(6 * pixels, 7.0f);
+  for (int i = 0; i < pixels; ++i)
+    for (int c = 0; c < 3; ++c)
+    {
+      padded[4 * i + c] = frame.xyz[3 * i + c];
+      spread[6 * i + 2 * c] = frame.xyz[3 * i + c];
+    }
+  CloudView packed_view = frame.view(), padded_view = packed_view, spread_view = packed_view;
+  padded_view.data = reinterpret_cast<const uint8_t*>(padded.data());
+  padded_view.point_step = 16;
+  padded_view.row_step = 16 * frame.width;
+  spread_view.data = reinterpret_cast<const uint8_t*>(spread.data());
+  spread_view.point_step = 24;
+  spread_view.row_step = 24 * frame.width;
+  spread_view.y_offset = 8;
+  spread_view.z_offset = 16;
+
+  NormalEstimatorConfig config;
+  config.window = 16;
+  config.stride = 8;
+  NormalEstimator packed, padded_estimator, spread_estimator;
+  std::vector<WindowSample> samples;
+  packed.compute(packed_view, pose, config, samples);
+  padded_estimator.compute(padded_view, pose, config, samples);
+  spread_estimator.compute(spread_view, pose, config, samples);
+  int compared = 0;
+  for (int by = 0; by < packed.blocksY(); ++by)
+    for (int bx = 0; bx < packed.blocksX(); ++bx)
+      for (const NormalEstimator* other : {&padded_estimator, &spread_estimator})
+      {
+        const PointMoments& a = packed.block(bx, by);
+        const PointMoments& b = other->block(bx, by);
+        ASSERT_EQ(a.count, b.count) << "block " << bx << ", " << by;
+        if (a.count < 3) continue;
+        EXPECT_LT((a.mean() - b.mean()).norm(), 1e-6) << "block " << bx << ", " << by;
+        EXPECT_LT((a.covariance() - b.covariance()).norm(), 1e-8) << "block " << bx << ", " << by;
+        ++compared;
+      }
+  EXPECT_GT(compared, 8000);
+}
