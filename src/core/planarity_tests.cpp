@@ -44,7 +44,13 @@ bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, s
   // A curved strip fits a plane within the noise, but its two halves tilt apart.
   const int bx_count = frame_.normals.blocksX();
   PointMoments all;
-  for (size_t i = begin; i < end; ++i) all.add(centroidMoments(frame_.normals.block(blocks[i] % bx_count, blocks[i] / bx_count)));
+  std::vector<PointMoments> centroids;  // each block's, for both axes
+  centroids.reserve(end - begin);
+  for (size_t i = begin; i < end; ++i)
+  {
+    centroids.push_back(centroidMoments(frame_.normals.block(blocks[i] % bx_count, blocks[i] / bx_count)));
+    all.add(centroids.back());
+  }
   if (all.count < 3) return true;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(all.covariance());
@@ -57,7 +63,7 @@ bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, s
     int half_blocks[2] = {0, 0};
     for (size_t i = begin; i < end; ++i)
     {
-      const PointMoments block = centroidMoments(frame_.normals.block(blocks[i] % bx_count, blocks[i] / bx_count));
+      const PointMoments& block = centroids[i - begin];
       const int h = direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0;
       halves[h].add(block);
       half_variance[h] += frame_.blocks[blocks[i]].centroid_variance + kCentroidFloor;
