@@ -34,15 +34,21 @@ void PlaneExtent::add(const Eigen::Vector3d& world_point, const Eigen::Vector3d&
   const int32_t x = static_cast<int32_t>(std::floor(point.x() / kCellSize));
   const int32_t y = static_cast<int32_t>(std::floor(point.y() / kCellSize));
   const uint64_t k = key(x, y);
-  const auto found = index_.find(k);
-  if (found == index_.end())
+  // Neighbouring blocks mostly fall in the cell before: no hash look-up for them.
+  if (last_added_ >= cells_.size() || cells_[last_added_].first != k)
   {
-    if (cells_.size() >= kMaxCells) return;  // bounded memory
-    index_.emplace(k, static_cast<uint32_t>(cells_.size()));
-    cells_.emplace_back(k, Cell{1.0f, frame});
-    return;
+    const auto found = index_.find(k);
+    if (found == index_.end())
+    {
+      if (cells_.size() >= kMaxCells) return;  // bounded memory
+      index_.emplace(k, static_cast<uint32_t>(cells_.size()));
+      last_added_ = cells_.size();
+      cells_.emplace_back(k, Cell{1.0f, frame});
+      return;
+    }
+    last_added_ = found->second;
   }
-  Cell& cell = cells_[found->second].second;
+  Cell& cell = cells_[last_added_].second;
   // Fading is applied lazily: a cell's weight is brought up to date when it is touched.
   cell.weight = std::min(kMaxWeight, std::max(0.0f, weightAt(cell, frame, fade)) + 1.0f);
   cell.seen = frame;

@@ -107,6 +107,7 @@ private:
   // each key's position in it for the per-block look-up of add().
   std::vector<std::pair<uint64_t, Cell>> cells_;
   std::unordered_map<uint64_t, uint32_t> index_;
+  size_t last_added_ = 0;  // position of the cell add() marked last (checked against its key)
   std::shared_ptr<const PlaneBasis> basis_;
 };
 
