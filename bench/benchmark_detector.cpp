@@ -12,6 +12,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "hough_plane_detector/core/normal_estimator.h"
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/core/plane_geometry.h"
 #include "hough_plane_detector/core/symmetric_eigen.h"
@@ -111,9 +112,47 @@ void benchEigenSolvers(const std::vector<RenderedFrame>& rendered)
               scatters.size(), closed_form_ns, ours_ns, worst_angle);
 }
 
+// The normals' per-block sums: four pixels at a time where x, y, z are consecutive floats (the
+// renderer's packed XYZ, as PCL's), against the field-by-field loop other layouts take (the
+// same frames with a gap after each coordinate). Median ms of NormalEstimator::compute.
+void benchBlockSums(const std::vector<RenderedFrame>& rendered)
+{
+  NormalEstimatorConfig config;
+  config.window = 32;
+  config.stride = 16;
+  NormalEstimator estimator;
+  std::vector<WindowSample> samples;
+  std::vector<double> consecutive_ms, by_field_ms;
+  for (const RenderedFrame& frame : rendered)
+  {
+    const CloudView packed = frame.view();
+    std::vector<float> spread_xyz(2 * frame.xyz.size());
+    for (size_t i = 0; i < frame.xyz.size(); ++i) spread_xyz[2 * i] = frame.xyz[i];
+    CloudView spread = packed;
+    spread.data = reinterpret_cast<const uint8_t*>(spread_xyz.data());
+    spread.point_step = 24;
+    spread.row_step = 24 * static_cast<size_t>(frame.width);
+    spread.y_offset = 8;
+    spread.z_offset = 16;
+    for (int repeat = 0; repeat < 3; ++repeat)
+    {
+      auto start = Clock::now();
+      estimator.compute(packed, frame.camera_to_world, config, samples);
+      consecutive_ms.push_back(msSince(start));
+      start = Clock::now();
+      estimator.compute(spread, frame.camera_to_world, config, samples);
+      by_field_ms.push_back(msSince(start));
+    }
+  }
+  std::printf("  of the normals: block sums and window normals of a frame, x y z consecutive (four pixels at a time) "
+              "%.3f ms, x y z apart (field by field) %.3f ms\n",
+              median(consecutive_ms), median(by_field_ms));
+}
+
 // What the options cost on the same frames: the paper's windows instead of block regions, and
 // the paper's thinning instead of forgetting by evidence (its check of the map's planes against
-// each frame); fitting the projection to each cloud; the normals' eigen-decompositions.
+// each frame); fitting the projection to each cloud; the normals' eigen-decompositions and
+// block sums.
 void benchVariants(const std::vector<RenderedFrame>& rendered)
 {
   const int frames = static_cast<int>(rendered.size());
@@ -151,6 +190,7 @@ void benchVariants(const std::vector<RenderedFrame>& rendered)
   }
   std::printf("  of the normals: the projection fitted to the cloud %.3f ms\n", median(intrinsics_ms));
   benchEigenSolvers(rendered);
+  benchBlockSums(rendered);
 }
 
 // Real Kinect frames, a still camera: each file five times into one map; PCL's methods once.
