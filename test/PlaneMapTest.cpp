@@ -1,6 +1,7 @@
 // The persistent map (paper 3.6-3.7, Alg. 2) fed with per-frame planes directly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "hough_plane_detector/core/plane_map.h"
@@ -120,6 +121,43 @@ TEST(PlaneMap, IdsFollowAPlaneThatMovesALittleAndNewPlanesGetNewOnes)
     else
       EXPECT_NE(plane.id, floor_id);
   }
+}
+
+// Two box tops 3.2 cm apart, each measured in the frame: their Gaussians pull the two peaks'
+// sub-voxel means under merge_distance, but a frame that measured two planes there saw two
+// surfaces, and the map keeps them apart also when the next frames see only one of them.
+// One face split into two regions of this frame (0.5 cm, 0.03 rad apart) stays one plane.
+TEST(PlaneMap, PlanesOneFrameMeasuredApartStayApartAndASplitFaceStaysOne)
+{
+  auto offsets = [](const std::vector<DetectedPlane>& planes) {
+    std::vector<double> d;
+    for (const DetectedPlane& plane : planes) d.push_back(std::abs(plane.d));
+    std::sort(d.begin(), d.end());
+    return d;
+  };
+  Map tops;
+  for (int f = 0; f < 4; ++f)
+  {
+    tops.frame({tops.plane(kFloor, -0.500, 20000), tops.plane(kFloor, -0.532, 20000)}, f);
+    const std::vector<double> d = offsets(tops.map.planes());
+    ASSERT_EQ(d.size(), 2u) << "frame " << f;
+    EXPECT_NEAR(d[0], 0.500, 0.006);  // each Gaussian's tail pulls the other's mean a little
+    EXPECT_NEAR(d[1], 0.532, 0.006);
+  }
+  for (int f = 4; f < 8; ++f)
+  {
+    tops.frame({tops.plane(kFloor, -0.500, 20000)}, f);
+    const std::vector<double> d = offsets(tops.map.planes());
+    ASSERT_EQ(d.size(), 2u) << "frame " << f;
+    EXPECT_NEAR(d[0], 0.500, 0.006);
+    EXPECT_NEAR(d[1], 0.532, 0.006);
+  }
+
+  Map split;
+  split.frame({split.plane(kFloor, -0.500, 20000),
+               split.plane(Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitX()) * kFloor, -0.505, 20000)},
+              0.0);
+  EXPECT_EQ(split.map.planes().size(), 1u);
 }
 
 // A plane one frame raised that no later frame supports: the paper's thinning takes it away at

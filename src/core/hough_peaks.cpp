@@ -105,7 +105,8 @@ std::vector<HoughPeak> HoughPeakSearch::extract(const SparseHoughSpace& space, c
 }
 
 std::vector<HoughPeak> mergeSimilarPeaks(std::vector<HoughPeak> peaks, double merge_angle, double merge_distance,
-                                         const HoughParameterization& param)
+                                         const HoughParameterization& param,
+                                         const std::function<bool(const HoughPeak&, const HoughPeak&)>& kept_apart)
 {
   std::sort(peaks.begin(), peaks.end(), [](const HoughPeak& a, const HoughPeak& b) { return a.value > b.value; });
   std::vector<HoughPeak> merged;
@@ -121,6 +122,7 @@ std::vector<HoughPeak> mergeSimilarPeaks(std::vector<HoughPeak> peaks, double me
       const double d2 = sign * peak.d;
       // Eq. 7-8: similar when both the normal angle and the d difference are small.
       if (unsignedAngle(m.normal, n2) > merge_angle || std::abs(m.d - d2) > merge_distance) continue;
+      if (kept_apart && kept_apart(m, peak)) continue;
       // Eq. 9-10: strength-weighted mean of normal and d.
       const double w1 = weights[i], w2 = peak.value;
       m.normal = ((w1 * m.normal + w2 * n2) / (w1 + w2)).normalized();

@@ -64,11 +64,42 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   const int evicted = static_cast<int>(global_.evictWeakest(static_cast<size_t>(params_.max_chunks)));
   chunks_evicted_total_ += evicted;
 
-  const std::vector<HoughPeak> peaks = mergeSimilarPeaks(peak_search_.extract(global_, seeds, params_.global_threshold),
-                                                         params_.merge_angle, params_.merge_distance, param_);
+  const std::vector<HoughPeak> peaks = mergeSimilarPeaks(
+      peak_search_.extract(global_, seeds, params_.global_threshold), params_.merge_angle, params_.merge_distance, param_,
+      [&](const HoughPeak& a, const HoughPeak& b) { return measuredApart(a, b, frame_planes); });
   matchIds(peaks, camera_position, stamp);
   if (params_.forgetting == kForgetByEvidence) carryBeliefs();
   return evicted;
+}
+
+bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const
+{
+  // Two nearby peaks are two surfaces when one frame measured a plane at each (two box tops a
+  // few cm apart), or the map already held them apart; else they are one plane's measurements.
+  auto cost = [&](const Eigen::Vector3d& normal, double d, const HoughPeak& peak) {
+    const double sign = normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
+    return unsignedAngle(normal, peak.normal) / params_.merge_angle + std::abs(sign * d - peak.d) / params_.merge_distance;
+  };
+  // Planes of one list, one nearer each peak, that eq. 7-8 would not merge themselves.
+  auto apart = [&](const auto& planes, bool need_dissimilar) {
+    for (const auto& near_a : planes)
+    {
+      const double a_to_a = cost(near_a.normal, near_a.d, a);
+      if (a_to_a > 1.0 || a_to_a >= cost(near_a.normal, near_a.d, b)) continue;
+      for (const auto& near_b : planes)
+      {
+        const double b_to_b = cost(near_b.normal, near_b.d, b);
+        if (b_to_b > 1.0 || b_to_b >= cost(near_b.normal, near_b.d, a)) continue;
+        if (!need_dissimilar) return true;
+        const double sign = near_a.normal.dot(near_b.normal) >= 0.0 ? 1.0 : -1.0;
+        if (unsignedAngle(near_a.normal, near_b.normal) > params_.merge_angle ||
+            std::abs(near_a.d - sign * near_b.d) > params_.merge_distance)
+          return true;
+      }
+    }
+    return false;
+  };
+  return apart(frame_planes, true) || apart(planes_, false);
 }
 
 void PlaneMap::thin(float cap, const std::vector<FramePlane>& frame_planes)

@@ -3,6 +3,7 @@
 // window's weighted mean; eq. 7-10 merge peaks of nearly the same plane.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -43,8 +44,10 @@ private:
 };
 
 // Eq. 7-10, strongest first: a peak within merge_angle and merge_distance of a kept one is
-// absorbed into it (value-weighted mean of normal and d).
-std::vector<HoughPeak> mergeSimilarPeaks(std::vector<HoughPeak> peaks, double merge_angle, double merge_distance,
-                                         const HoughParameterization& param);
+// absorbed into it (value-weighted mean of normal and d), unless `kept_apart` says the two
+// are different surfaces.
+std::vector<HoughPeak> mergeSimilarPeaks(
+    std::vector<HoughPeak> peaks, double merge_angle, double merge_distance, const HoughParameterization& param,
+    const std::function<bool(const HoughPeak&, const HoughPeak&)>& kept_apart = nullptr);
 
 }  // namespace hough_plane_detector

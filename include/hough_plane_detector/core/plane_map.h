@@ -74,6 +74,8 @@ private:
   bool samePlane(const DetectedPlane& known, const FramePlane& measured) const;
   // True when one of this frame's planes lies on `plane` within the merge tolerances.
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
+  // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
+  bool measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const;
   // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map.
   float voteWeight(const FramePlane& plane) const;
   // The space's peaks as the new plane list, ids carried over from the closest previous plane.
