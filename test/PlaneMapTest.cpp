@@ -103,6 +103,30 @@ TEST(PlaneMap, ASmallPatchParallelToAKnownPlaneIsReportedAtFirstSightOnlyWithThe
   EXPECT_EQ(larger.map.planes().size(), 1u);
 }
 
+TEST(PlaneMap, TwoPatchesOfOneSurfaceInOneFrameArePooledForTheFirstSightBar)
+{
+  // A box top at 0.55 m grown as two regions (0.5 cm and 0.03 rad apart, within the merge
+  // tolerances): each alone is under the parallel bar and waits; together they measure one
+  // plane, reported at first sight. Two patches 4 cm apart are two planes and each waits.
+  const double support = 1088, weighted = 0.9 * Map().params.strong_support;
+  auto patch = [&](Map& m, const Eigen::Vector3d& normal, double d) {
+    FramePlane p = m.plane(normal, d, support, weighted);
+    p.parallel = true;
+    return p;
+  };
+  const Eigen::Vector3d tilted = Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitX()) * kFloor;
+  Map alone;
+  alone.frame({patch(alone, kFloor, -0.524)}, 0.0);
+  EXPECT_TRUE(alone.map.planes().empty());
+  Map split;
+  split.frame({patch(split, kFloor, -0.524), patch(split, tilted, -0.519)}, 0.0);
+  ASSERT_EQ(split.map.planes().size(), 1u);
+  EXPECT_NEAR(std::abs(split.map.planes()[0].d), 0.52, 0.006);
+  Map apart;
+  apart.frame({patch(apart, kFloor, -0.524), patch(apart, kFloor, -0.564)}, 0.0);
+  EXPECT_TRUE(apart.map.planes().empty());
+}
+
 TEST(PlaneMap, IdsFollowAPlaneThatMovesALittleAndNewPlanesGetNewOnes)
 {
   Map m;

@@ -54,7 +54,7 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   std::vector<Eigen::Vector3i> seeds;
   for (const FramePlane& plane : frame_planes)
   {
-    const float weight = voteWeight(plane);
+    const float weight = voteWeight(plane, frame_planes);
     voting_.addGaussian(global_, plane.hough, weight, cap);
     Eigen::Vector3d mirrored;
     if (param_.mirror(plane.hough, mirrored)) voting_.addGaussian(global_, mirrored, weight, cap);
@@ -111,7 +111,7 @@ void PlaneMap::thin(float cap, const std::vector<FramePlane>& frame_planes)
     global_.thin(static_cast<float>(params_.thinning_rate), cap);
 }
 
-float PlaneMap::voteWeight(const FramePlane& plane) const
+float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes) const
 {
   // A plane not yet in the map adds up to 2 when strongly supported, so that a big plane is
   // reported the first time it is seen, while known planes gain 1 per frame as in the paper
@@ -125,8 +125,21 @@ float PlaneMap::voteWeight(const FramePlane& plane) const
     if (samePlane(known, plane)) return 1.0f;
   if (params_.strong_support <= 0) return 1.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
-  const double points = plane.first_sight_points;
-  if (plane.support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
+  // One surface the frame grew as two regions (a box top split by a label's gap) is measured
+  // by all of them: its points are pooled over this frame's planes the merge would join.
+  double points = plane.first_sight_points, support = plane.support;
+  for (const FramePlane& other : frame_planes)
+  {
+    if (&other == &plane) continue;
+    const double sign = other.normal.dot(plane.normal) >= 0.0 ? 1.0 : -1.0;
+    if (unsignedAngle(other.normal, plane.normal) < params_.merge_angle &&
+        std::abs(sign * other.d - plane.d) < params_.merge_distance)
+    {
+      points += other.first_sight_points;
+      support += other.support;
+    }
+  }
+  if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
   return static_cast<float>(1.0 + std::min(1.0, points / (plane.parallel ? 0.25 * strong_support : strong_support)));
 }
 

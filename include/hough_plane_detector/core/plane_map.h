@@ -77,7 +77,7 @@ private:
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
   bool measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const;
   // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map.
-  float voteWeight(const FramePlane& plane) const;
+  float voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes) const;
   // The space's peaks as the new plane list, ids carried over from the closest previous plane.
   void matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp);
   // Beliefs follow the ids: new planes start afresh, planes that left the map take theirs along.
