@@ -125,7 +125,7 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
     if (samePlane(known, plane)) return 1.0f;
   if (params_.strong_support <= 0) return 1.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
-  // One surface the frame grew as two regions (a box top split by a label's gap) is measured
+  // One surface the frame grew as two regions (a box top split in two) is measured
   // by all of them: its points are pooled over this frame's planes the merge would join.
   double points = plane.first_sight_points, support = plane.support;
   for (const FramePlane& other : frame_planes)
