@@ -1,5 +1,3 @@
-#include <cstdio>
-#include <cstdlib>
 #include "hough_plane_detector/core/frame_planes.h"
 
 #include <algorithm>
@@ -389,7 +387,6 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // likelihood-ratio test (2 degrees of freedom, the normal's), else a box face a few degrees
   // off an older box's would take its direction. Judged on the interior: rim blocks straddling
   // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
-  if (getenv("SNAPDBG")) { std::vector<int> interior = interiorBlocks(inliers, frame_.blocksX(), frame_.blocksY()); fprintf(stderr, "snap try: angle %.4f blocks %zu inliers %zu interior %zu chi2inc(all) %.2f chi2inc(int) %.2f normalsd %.4f d %.4f\n", unsignedAngle(known, normal), blocks.size(), inliers.size(), interior.size(), tests_.snapChi2Increase(n_cam, inliers), tests_.snapChi2Increase(n_cam, interior), tests_.normalUncertainty(inliers), d); }
   if (!tests_.explainedByNormal(n_cam, inliers)) return false;
   normal = known;
   d = frame_.dInWorld(known, d_cam);
