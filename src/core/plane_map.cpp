@@ -125,8 +125,9 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
     if (samePlane(known, plane)) return 1.0f;
   if (params_.strong_support <= 0) return 1.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
-  // One surface the frame grew as two regions (a box top split in two) is measured
-  // by all of them: its points are pooled over this frame's planes the merge would join.
+  // Whether a surface is too small for the curvature tests does not depend on how many regions
+  // the frame grew on it (a box top split in two): that test pools the points and support of
+  // this frame's planes the merge would join. The weight is each measurement's own.
   double points = plane.first_sight_points, support = plane.support;
   for (const FramePlane& other : frame_planes)
   {
@@ -140,7 +141,8 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
     }
   }
   if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
-  return static_cast<float>(1.0 + std::min(1.0, points / (plane.parallel ? 0.25 * strong_support : strong_support)));
+  const double bar = plane.parallel ? 0.25 * strong_support : strong_support;
+  return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
 }
 
 bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured) const

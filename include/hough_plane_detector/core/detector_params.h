@@ -73,9 +73,9 @@ struct DetectorParams
   // kStrongSupportDepth counts (sigma there / sigma at its depth)^2: near the sensor one
   // frame's tests see the folds and bends noise hides farther away. A plane of under
   // 2 min_support points needs a second frame (too small for the curvature tests), unless it is
-  // parallel to a known plane and its weighted points reach strong_support itself. Points and
-  // support are pooled over the frame's planes within the merge tolerances of each other (one
-  // surface grown as two regions).
+  // parallel to a known plane and its weighted points reach strong_support itself. That test
+  // pools points and support over the frame's planes within the merge tolerances of each other
+  // (one surface grown as two regions); the weight added is each plane's own.
   int strong_support = 16000;
   // Amount every global cell loses per frame (paper 3.7: 0.01 - 0.1).
   double thinning_rate = 0.05;
