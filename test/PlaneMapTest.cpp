@@ -124,8 +124,10 @@ TEST(PlaneMap, TwoPatchesOfOneSurfaceInOneFrameArePooledForTheFirstSightBar)
   EXPECT_NEAR(std::abs(split.map.planes()[0].d), 0.52, 0.006);
   Map apart;
   apart.frame({patch(apart, kFloor, -0.524), patch(apart, kFloor, -0.564)}, 0.0);
-  EXPECT_TRUE(apart.map.planes().empty());  // Pooling decides only whether the surface is too small to be judged; each region still votes
-  // its own weight: two large regions 2.5 cm apart, 0.3 strong_support each, wait as each would alone.
+  EXPECT_TRUE(apart.map.planes().empty());
+  // Pooling decides only whether the surface is too small to be judged; each region still votes
+  // its own weight: two large regions 2.5 cm apart, 0.3 strong_support each, wait as each would
+  // alone.
   Map weak;
   const double half_bar = 0.3 * weak.params.strong_support;
   weak.frame({weak.plane(kFloor, -1.0, 4000, half_bar), weak.plane(kFloor, -1.025, 4000, half_bar)}, 0.0);

@@ -64,9 +64,10 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   const int evicted = static_cast<int>(global_.evictWeakest(static_cast<size_t>(params_.max_chunks)));
   chunks_evicted_total_ += evicted;
 
-  const std::vector<HoughPeak> peaks = mergeSimilarPeaks(
-      peak_search_.extract(global_, seeds, params_.global_threshold), params_.merge_angle, params_.merge_distance, param_,
-      [&](const HoughPeak& a, const HoughPeak& b) { return measuredApart(a, b, frame_planes); });
+  const std::vector<HoughPeak> peaks =
+      mergeSimilarPeaks(peak_search_.extract(global_, seeds, params_.global_threshold), params_.merge_angle,
+                        params_.merge_distance, param_,
+                        [&](const HoughPeak& a, const HoughPeak& b) { return measuredApart(a, b, frame_planes); });
   matchIds(peaks, camera_position, stamp);
   if (params_.forgetting == kForgetByEvidence) carryBeliefs();
   return evicted;
@@ -78,7 +79,8 @@ bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::
   // few cm apart), or the map already held them apart; else they are one plane's measurements.
   auto cost = [&](const Eigen::Vector3d& normal, double d, const HoughPeak& peak) {
     const double sign = normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
-    return unsignedAngle(normal, peak.normal) / params_.merge_angle + std::abs(sign * d - peak.d) / params_.merge_distance;
+    return unsignedAngle(normal, peak.normal) / params_.merge_angle +
+           std::abs(sign * d - peak.d) / params_.merge_distance;
   };
   // Planes of one list, one nearer each peak, that eq. 7-8 would not merge themselves.
   auto apart = [&](const auto& planes, bool need_dissimilar) {
@@ -90,10 +92,9 @@ bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::
       {
         const double b_to_b = cost(near_b.normal, near_b.d, b);
         if (b_to_b > 1.0 || b_to_b >= cost(near_b.normal, near_b.d, a)) continue;
-        if (!need_dissimilar) return true;
-        const double sign = near_a.normal.dot(near_b.normal) >= 0.0 ? 1.0 : -1.0;
-        if (unsignedAngle(near_a.normal, near_b.normal) > params_.merge_angle ||
-            std::abs(near_a.d - sign * near_b.d) > params_.merge_distance)
+        if (!need_dissimilar ||
+            !withinMergeTolerances(near_a.normal, near_a.d, near_b.normal, near_b.d, params_.merge_angle,
+                                   params_.merge_distance))
           return true;
       }
     }
@@ -131,10 +132,8 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   double points = plane.first_sight_points, support = plane.support;
   for (const FramePlane& other : frame_planes)
   {
-    if (&other == &plane) continue;
-    const double sign = other.normal.dot(plane.normal) >= 0.0 ? 1.0 : -1.0;
-    if (unsignedAngle(other.normal, plane.normal) < params_.merge_angle &&
-        std::abs(sign * other.d - plane.d) < params_.merge_distance)
+    if (&other != &plane && withinMergeTolerances(plane.normal, plane.d, other.normal, other.d, params_.merge_angle,
+                                                  params_.merge_distance))
     {
       points += other.first_sight_points;
       support += other.support;
@@ -147,9 +146,8 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
 
 bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured) const
 {
-  const double sign = known.normal.dot(measured.normal) >= 0.0 ? 1.0 : -1.0;
-  return unsignedAngle(known.normal, measured.normal) < params_.merge_angle &&
-         std::abs(known.d - sign * measured.d) < params_.merge_distance;
+  return withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, params_.merge_angle,
+                               params_.merge_distance);
 }
 
 bool PlaneMap::remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const

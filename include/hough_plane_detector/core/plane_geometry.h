@@ -17,6 +17,15 @@ inline double unsignedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
   return std::acos(std::min(1.0, std::abs(a.dot(b))));
 }
 
+// Eq. 7-8: two planes are one when both their normals' angle and their offsets' difference
+// (after aligning the normals' signs) are under the merge tolerances.
+inline bool withinMergeTolerances(const Eigen::Vector3d& normal_a, double d_a, const Eigen::Vector3d& normal_b,
+                                  double d_b, double merge_angle, double merge_distance)
+{
+  const double sign = normal_a.dot(normal_b) >= 0.0 ? 1.0 : -1.0;
+  return unsignedAngle(normal_a, normal_b) < merge_angle && std::abs(d_a - sign * d_b) < merge_distance;
+}
+
 // Nearest integer cell of continuous cell coordinates.
 inline Eigen::Vector3i nearestCell(const Eigen::Vector3d& cell)
 {
