@@ -50,6 +50,26 @@ TEST(HoughPeaks, ClimbsToTheTopAndRefinesBelowACell)
   EXPECT_NEAR(normal.dot(peaks[0].normal), 1.0, 1e-12);
 }
 
+TEST(HoughPeaks, APeaksHeightDoesNotDependOnWhereBetweenTheCellsItFell)
+{
+  // One Gaussian of weight 2 half a cell off on every axis reads 2 exp(-3/8) = 1.37 at its
+  // nearest cell; its height from the cells' log values is 2 wherever it fell.
+  for (const Eigen::Vector3d& offset :
+       {Eigen::Vector3d(0.5, 0.5, 0.5), Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(-0.3, 0.45, 0.1)})
+  {
+    Space s;
+    const Eigen::Vector3d centre = Eigen::Vector3d(120, 130, 900) + offset;
+    s.gaussianAt(centre, 2.0f);
+    const Eigen::Vector3i top = s.search.climb(s.space, rounded(centre));
+    EXPECT_NEAR(s.search.peakHeight(s.space, top), 2.0, 1e-4) << offset.transpose();
+    // Judged by height, the peak passes 1.5; by its cell only when it fell near the centre
+    // (the cell reads 2 exp(-|offset|^2 / 2) with the blur's sigma of 1 cell).
+    EXPECT_EQ(s.search.extract(s.space, {top}, 1.5, {1}).size(), 1u);
+    const size_t by_cell = 2.0 * std::exp(-0.5 * offset.squaredNorm()) >= 1.5 ? 1u : 0u;
+    EXPECT_EQ(s.search.extract(s.space, {top}, 1.5).size(), by_cell) << offset.transpose();
+  }
+}
+
 TEST(HoughPeaks, SeedsOfOnePeakGiveItOnceAndTheThresholdDropsWeakOnes)
 {
   Space s;

@@ -65,6 +65,27 @@ TEST(PlaneMap, AWeakPlaneNeedsASecondFrameAStrongOneDoesNot)
   EXPECT_GT(wall.normal.dot(Eigen::Vector3d::Zero()) + wall.d, 0.0);  // faces the sensor at the origin
 }
 
+TEST(PlaneMap, AStrongPlaneIsReportedAtFirstSightWhereverBetweenTheCellsItFalls)
+{
+  // Half a cell off on every Hough axis, a vote of 2 reads 1.37 at its nearest cell, under
+  // global_threshold 1.5: a plane of strong_support points is still reported from its frame.
+  // One of 0.6 strong_support (a vote of 1.6) is judged by its cell and waits there.
+  Map probe;
+  const Eigen::Vector3d corner = probe.param.toCell(probe.param.toHough(Eigen::Vector3d(0.3, -0.2, 1.0).normalized(), -1.2))
+                                     .array()
+                                     .floor() +
+                                 0.5;
+  Eigen::Vector3d normal;
+  double d;
+  probe.param.fromHough(probe.param.fromCell(corner), normal, d);
+  Map strong;
+  strong.frame({strong.plane(normal, d, strong.params.strong_support)}, 0.0);
+  EXPECT_EQ(strong.map.planes().size(), 1u);
+  Map weaker;
+  weaker.frame({weaker.plane(normal, d, 0.6 * weaker.params.strong_support)}, 0.0);
+  EXPECT_TRUE(weaker.map.planes().empty());
+}
+
 TEST(PlaneMap, NearPointsCountByTheirPrecisionButASmallPatchWaits)
 {
   // 3,000 points at 1 m measure a plane like 48,000 at 2 m (Kinect noise grows with depth^2).

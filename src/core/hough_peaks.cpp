@@ -80,18 +80,42 @@ Eigen::Vector3d HoughPeakSearch::subVoxelMean(const SparseHoughSpace& space, con
   return cell.cast<double>() + (total > 0.0 ? Eigen::Vector3d(weighted / total) : Eigen::Vector3d::Zero());
 }
 
+double HoughPeakSearch::peakHeight(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const
+{
+  // A Gaussian's logarithm is a parabola along each axis: three samples give its height at the
+  // vertex wherever between cells the plane fell (a lone vote of weight w half a cell off on all
+  // three axes reads 0.69 w at its nearest cell).
+  const double centre = space.value(cell.x(), cell.y(), cell.z());
+  if (!(centre > 0.0)) return centre;
+  const double log_centre = std::log(centre);
+  double log_height = log_centre;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    Eigen::Vector3i below = cell, above = cell;
+    --below(axis);
+    ++above(axis);
+    const double l = space.value(below.x(), below.y(), below.z()), r = space.value(above.x(), above.y(), above.z());
+    if (!(l > 0.0 && r > 0.0)) continue;
+    const double log_l = std::log(l), log_r = std::log(r), curvature = log_l - 2.0 * log_centre + log_r;
+    if (!(curvature < 0.0)) continue;  // a plateau (capped cells): the cell is the height
+    log_height -= (log_l - log_r) * (log_l - log_r) / (8.0 * curvature);
+  }
+  return std::exp(log_height);
+}
+
 std::vector<HoughPeak> HoughPeakSearch::extract(const SparseHoughSpace& space, const std::vector<Eigen::Vector3i>& seeds,
-                                                double threshold) const
+                                                double threshold, const std::vector<char>& full_height) const
 {
   std::vector<HoughPeak> peaks;
   std::unordered_set<int64_t> visited;
   const int64_t sy = space.sizeY(), sz = space.sizeZ();
-  for (const Eigen::Vector3i& seed : seeds)
+  for (size_t i = 0; i < seeds.size(); ++i)
   {
-    const Eigen::Vector3i top = climb(space, seed);
+    const Eigen::Vector3i top = climb(space, seeds[i]);
     if (!visited.insert((static_cast<int64_t>(top.x()) * sy + top.y()) * sz + top.z()).second) continue;
     const float value = space.value(top.x(), top.y(), top.z());
-    if (value < threshold || !isWindowMaximum(space, top)) continue;
+    const bool by_height = i < full_height.size() && full_height[i];
+    if ((by_height ? peakHeight(space, top) : value) < threshold || !isWindowMaximum(space, top)) continue;
     HoughPeak peak;
     peak.hough = param_.fromCell(subVoxelMean(space, top));
     // Mirrored twins beyond the border are the same plane. A peak right on the border may

@@ -51,10 +51,14 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   thin(cap, frame_planes);
   // Algorithm 2: every frame plane adds one Gaussian; the peaks are seeded from the cells of
   // this frame's planes and of the map's.
+  // A plane this frame measured strongly enough to be reported at first sight (weight 2) is
+  // judged by its peak's height, not by its nearest cell, which reads 1.37-2 by where it fell.
   std::vector<Eigen::Vector3i> seeds;
+  std::vector<char> full_height;
   for (const FramePlane& plane : frame_planes)
   {
     const float weight = voteWeight(plane, frame_planes);
+    full_height.push_back(weight >= 2.0f);
     voting_.addGaussian(global_, plane.hough, weight, cap);
     Eigen::Vector3d mirrored;
     if (param_.mirror(plane.hough, mirrored)) voting_.addGaussian(global_, mirrored, weight, cap);
@@ -65,8 +69,8 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   chunks_evicted_total_ += evicted;
 
   const std::vector<HoughPeak> peaks =
-      mergeSimilarPeaks(peak_search_.extract(global_, seeds, params_.global_threshold), params_.merge_angle,
-                        params_.merge_distance, param_,
+      mergeSimilarPeaks(peak_search_.extract(global_, seeds, params_.global_threshold, full_height),
+                        params_.merge_angle, params_.merge_distance, param_,
                         [&](const HoughPeak& a, const HoughPeak& b) { return measuredApart(a, b, frame_planes); });
   matchIds(peaks, camera_position, stamp);
   if (params_.forgetting == kForgetByEvidence) carryBeliefs();

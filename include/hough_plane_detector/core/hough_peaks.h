@@ -29,14 +29,18 @@ public:
   HoughPeakSearch(const HoughParameterization& param, int peak_radius);
 
   // Peaks reached from the seeds, each once, at least `threshold` high.
+  // A peak reached from a seed marked in `full_height` is judged by its height between the
+  // cells (peakHeight), not by its cell's value.
   std::vector<HoughPeak> extract(const SparseHoughSpace& space, const std::vector<Eigen::Vector3i>& seeds,
-                                 double threshold) const;
+                                 double threshold, const std::vector<char>& full_height = {}) const;
   // Climbs from a cell to the local maximum under the (value, -index) total order.
   Eigen::Vector3i climb(const SparseHoughSpace& space, Eigen::Vector3i cell) const;
   // True when no cell of the peak window beats the cell under that order.
   bool isWindowMaximum(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const;
   // Eq. 6: m(x) = sum h(p) p / sum h(p) over the peak window, in cell coordinates.
   Eigen::Vector3d subVoxelMean(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const;
+  // Height of the peak between the cells: a parabola through the log values on each axis.
+  double peakHeight(const SparseHoughSpace& space, const Eigen::Vector3i& cell) const;
 
 private:
   const HoughParameterization& param_;
