@@ -71,10 +71,8 @@ TEST(PlaneMap, AStrongPlaneIsReportedAtFirstSightWhereverBetweenTheCellsItFalls)
   // global_threshold 1.5: a plane of strong_support points is still reported from its frame.
   // One of 0.6 strong_support (a vote of 1.6) is judged by its cell and waits there.
   Map probe;
-  const Eigen::Vector3d corner = probe.param.toCell(probe.param.toHough(Eigen::Vector3d(0.3, -0.2, 1.0).normalized(), -1.2))
-                                     .array()
-                                     .floor() +
-                                 0.5;
+  const Eigen::Vector3d hough = probe.param.toHough(Eigen::Vector3d(0.3, -0.2, 1.0).normalized(), -1.2);
+  const Eigen::Vector3d corner = probe.param.toCell(hough).array().floor() + 0.5;  // between 8 cells
   Eigen::Vector3d normal;
   double d;
   probe.param.fromHough(probe.param.fromCell(corner), normal, d);
