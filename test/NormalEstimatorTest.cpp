@@ -114,7 +114,6 @@ TEST(NormalEstimator, MomentsTransformLikeThePoints)
   EXPECT_NEAR((moved.covariance() - moved_direct.covariance()).norm(), 0.0, 1e-12);
 }
 
-
 TEST(NormalEstimator, BlockMomentsDoNotDependOnThePointLayout)
 {
   // Packed x y z (12 bytes), padded x y z _ (16 bytes) and x _ y _ z _ (24 bytes, read field by

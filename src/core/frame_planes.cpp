@@ -177,7 +177,6 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
   frame_.block_claim.assign(frame_.blocks.size(), 0);
   std::vector<char> tried(frame_.blocks.size(), 0);
   BlockRegionGrower grower(frame_.normals, frame_.blocks, params_);
-  const Eigen::Matrix3d world_to_camera = frame_.camera_to_world.linear().transpose();
   auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
     PlaneRegion region = grower.grow(seed, n_cam, d_cam, frame_.block_claim);
     for (int b : region.blocks) tried[b] = 1;
@@ -202,7 +201,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
   constexpr size_t kMinSeedBlocks = 2;
   for (const HoughPeak& peak : peaks)
   {
-    const Eigen::Vector3d n_cam = world_to_camera * peak.normal;
+    const Eigen::Vector3d n_cam = frame_.normalInCamera(peak.normal);
     const double d_cam = frame_.dInCamera(peak.normal, peak.d);
     for (const std::vector<int>& seed : grower.seedComponents(n_cam, d_cam, frame_.block_claim))
     {

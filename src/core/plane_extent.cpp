@@ -41,9 +41,8 @@ void PlaneExtent::add(const Eigen::Vector3d& world_point, const Eigen::Vector3d&
     if (found == index_.end())
     {
       if (cells_.size() >= kMaxCells) return;  // bounded memory
-      index_.emplace(k, static_cast<uint32_t>(cells_.size()));
       last_added_ = cells_.size();
-      cells_.emplace_back(k, Cell{1.0f, frame});
+      appendCell(k, Cell{1.0f, frame});
       return;
     }
     last_added_ = found->second;
@@ -431,11 +430,17 @@ std::vector<std::pair<std::pair<int32_t, int32_t>, PlaneExtent::Cell>> PlaneExte
 void PlaneExtent::setCell(int32_t x, int32_t y, const Cell& cell)
 {
   const uint64_t k = key(x, y);
-  const auto inserted = index_.emplace(k, static_cast<uint32_t>(cells_.size()));
-  if (inserted.second)
-    cells_.emplace_back(k, cell);
+  const auto found = index_.find(k);
+  if (found == index_.end())
+    appendCell(k, cell);
   else
-    cells_[inserted.first->second].second = cell;
+    cells_[found->second].second = cell;
+}
+
+void PlaneExtent::appendCell(uint64_t k, const Cell& cell)
+{
+  index_.emplace(k, static_cast<uint32_t>(cells_.size()));
+  cells_.emplace_back(k, cell);
 }
 
 }  // namespace hough_plane_detector

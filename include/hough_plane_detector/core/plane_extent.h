@@ -103,6 +103,8 @@ private:
   // kMinRegionCells cells.
   std::vector<std::vector<std::pair<int32_t, int32_t>>> connectedRegions(int64_t frame, float fade) const;
   std::vector<PlaneOutline> outlinesOf(const std::vector<std::pair<int32_t, int32_t>>& region) const;
+  // A new cell at the end of the array, and its position in the index.
+  void appendCell(uint64_t k, const Cell& cell);
   // The cells as (key, cell) in one array, which every pass over the extent walks in order, and
   // each key's position in it for the per-block look-up of add().
   std::vector<std::pair<uint64_t, Cell>> cells_;
