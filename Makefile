@@ -35,7 +35,7 @@ REAL_FRAMES := $(wildcard ../shared/data/kinect-real/*.pcd)
 # Debian's ROS Python modules live under /usr; a pyenv python first on PATH breaks catkin.
 export PATH := /usr/bin:$(PATH)
 
-.PHONY: all help deps build test tsan tsan-control fuzz soak soak-control demo demo-offline bench evaluate clean
+.PHONY: all help deps build test tsan tsan-control fuzz soak soak-control demo demo-offline bench evaluate tuning-check clean
 
 all: build
 
@@ -51,6 +51,7 @@ help:
 	@echo "make demo-offline  the core alone on the simulated room, with per-frame figures"
 	@echo "make bench         time per frame and accuracy against PCL RANSAC and OMPS"
 	@echo "make evaluate      the paper's experiments, held-out rooms, real frames -> docs/RESULTS.md (QUICK=1: short)"
+	@echo "make tuning-check  the rendered sets a detector change may be tuned on, one line each, and osd-learn (ARGS=--causes, --PARAM VALUE)"
 	@echo "make soak          10,000 frames through the core, then the nodelet (memory, ms, valgrind's leak checks)"
 	@echo "make soak-control  the leak check's negative control (must report a leak)"
 	@echo "make clean         remove build/"
@@ -114,6 +115,11 @@ EVALUATE_DIR := $(if $(QUICK),build/evaluate-quick,docs)
 evaluate: build
 	@scripts/install_deps.sh gnuplot-nox
 	@scripts/evaluate.sh $(BIN) $(EVALUATE_DIR) $(if $(QUICK),1,0) $(REAL_FRAMES)
+
+# While changing the detector: the sets it may be tuned on (no held-out seeds), a minute or two.
+OSD_LEARN := ../shared/data/osd-learn
+tuning-check: build
+	$(BIN)/tuning_check $(if $(wildcard $(OSD_LEARN)/annotations.json),--osd $(OSD_LEARN)) $(ARGS)
 
 # 10,000 simulated frames through one detector (the core) and then through the nodelet in a
 # manager: resident memory, chunks, planes, ms; valgrind's leak check over short runs of both.

@@ -28,13 +28,6 @@ double ransacThreshold(double noise)
   return 0.05;
 }
 
-namespace
-{
-const double kNoiseLevels[] = {0.0, 0.3, 1.0, 4.0};
-constexpr double kRoomNoise = 1.0;
-constexpr int kRoomRansacIterations = 500;
-
-// Our only noise-dependent knob: the C of eq. 11 the planarity test expects.
 DetectorParams paramsFor(double noise, int resolution)
 {
   DetectorParams p;
@@ -43,26 +36,6 @@ DetectorParams paramsFor(double noise, int resolution)
   return p;
 }
 
-// Fig. 6-8 as the paper ran them: its thinning (paper 3.7) instead of the default evidence.
-DetectorParams paperParamsFor(double noise, int resolution)
-{
-  DetectorParams p = paramsFor(noise, resolution);
-  p.forgetting = kForgetByThinning;
-  return p;
-}
-
-std::vector<RenderedFrame> renderSequence(const SceneRenderer& renderer, const std::vector<Eigen::Isometry3d>& poses,
-                                          double noise, uint32_t seed)
-{
-  KinectNoise kinect;
-  kinect.coefficient = noise;
-  std::vector<RenderedFrame> frames;
-  for (size_t f = 0; f < poses.size(); ++f) frames.push_back(renderer.render(poses[f], kinect, seed + f));
-  return frames;
-}
-
-// Why our detector missed a visible true plane in a frame: the fate of the local peak that
-// matches it, or no peak at all, or a per-frame plane the map has not reported yet.
 std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
 {
   const MatchTolerance tolerance;
@@ -83,17 +56,48 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
   return std::string(toString(best->verdict)) + (best->parallel_search ? " (parallel search)" : "");
 }
 
-struct NamedScene
-{
-  const char* name;
-  Scene scene;
-};
-
 std::vector<NamedScene> tableThreeScenes()
 {
   return {{"office (table, cabinet, shelf, pillar, ball)", makeOfficeRoom()},
           {"hall (ramp, stairs, recessed door, pillar, ball)", makeRampStairsHall()},
           {"lab (desks, cabinets, crate, bins, balls)", makeClutteredLab()}};
+}
+
+std::vector<TourPath> otherTourPaths()
+{
+  // The first five were used while developing the snap to a known normal (to refuse variants
+  // that made false planes there); the last two were first run after the detector was fixed.
+  return {{"A: Table 3's path, noise seed 5000", 60, {0, 0, 1.0}, 0.5, 5000},
+          {"B: Table 3's path, noise seed 77000", 60, {0, 0, 1.0}, 0.5, 77000},
+          {"C: 45 poses on Table 3's circle", 45, {0, 0, 1.0}, 0.5, 300},
+          {"D: circle of 0.7 m about (0.3, -0.2), 50 poses", 50, {0.3, -0.2, 1.0}, 0.7, 900},
+          {"E: circle of 0.4 m about (-0.4, 0.3), camera 1.3 m high, 40 poses", 40, {-0.4, 0.3, 1.3}, 0.4, 1700},
+          {"F: circle of 0.3 m about (0.5, 0.4), camera 1.1 m high, 55 poses", 55, {0.5, 0.4, 1.1}, 0.3, 2024},
+          {"G: circle of 0.6 m about (-0.2, -0.5), camera 0.9 m high, 48 poses", 48, {-0.2, -0.5, 0.9}, 0.6, 3131}};
+}
+
+namespace
+{
+const double kNoiseLevels[] = {0.0, 0.3, 1.0, 4.0};
+constexpr double kRoomNoise = 1.0;
+constexpr int kRoomRansacIterations = 500;
+
+// Fig. 6-8 as the paper ran them: its thinning (paper 3.7) instead of the default evidence.
+DetectorParams paperParamsFor(double noise, int resolution)
+{
+  DetectorParams p = paramsFor(noise, resolution);
+  p.forgetting = kForgetByThinning;
+  return p;
+}
+
+std::vector<RenderedFrame> renderSequence(const SceneRenderer& renderer, const std::vector<Eigen::Isometry3d>& poses,
+                                          double noise, uint32_t seed)
+{
+  KinectNoise kinect;
+  kinect.coefficient = noise;
+  std::vector<RenderedFrame> frames;
+  for (size_t f = 0; f < poses.size(); ++f) frames.push_back(renderer.render(poses[f], kinect, seed + f));
+  return frames;
 }
 
 // Our map through a tour of one scene at C = 1.0, scored on every stride-th frame from
@@ -149,7 +153,7 @@ NoiseExperiment runNoiseExperiment(bool quick)
   for (double noise : kNoiseLevels)
   {
     std::fprintf(stderr, "  noise C = %.1f: rendering %d frames\n", noise, frames);
-    const auto rendered = renderSequence(renderer, poses, noise, 7000);
+    const auto rendered = renderSequence(renderer, poses, noise, kNoiseTourSeed);
     NoiseLevelResult level;
     level.noise = noise;
     for (int r = 0; r < kResolutionCount; ++r)
@@ -244,37 +248,21 @@ RoomExperiment runRoomTours(bool quick)
   {
     std::fprintf(stderr, "  Table 3: %s\n", named.name);
     result.scenes.push_back(
-        {named.name, runTour(named.scene, roomTour(result.frames), 11000, result.stride, true, result.causes)});
+        {named.name, runTour(named.scene, roomTour(result.frames), kRoomTourSeed, result.stride, true, result.causes)});
   }
   return result;
 }
 
 OtherToursExperiment runOtherTours(bool quick)
 {
-  struct Tour
-  {
-    const char* name;
-    int frames;
-    Eigen::Vector3d centre;
-    double radius;
-    uint32_t seed;
-  };
-  // The first five were used while developing the snap to a known normal (to refuse variants
-  // that made false planes there); the last two were first run after the detector was fixed.
-  const Tour tours[] = {{"A: Table 3's path, noise seed 5000", 60, {0, 0, 1.0}, 0.5, 5000},
-                        {"B: Table 3's path, noise seed 77000", 60, {0, 0, 1.0}, 0.5, 77000},
-                        {"C: 45 poses on Table 3's circle", 45, {0, 0, 1.0}, 0.5, 300},
-                        {"D: circle of 0.7 m about (0.3, -0.2), 50 poses", 50, {0.3, -0.2, 1.0}, 0.7, 900},
-                        {"E: circle of 0.4 m about (-0.4, 0.3), camera 1.3 m high, 40 poses", 40, {-0.4, 0.3, 1.3}, 0.4, 1700},
-                        {"F: circle of 0.3 m about (0.5, 0.4), camera 1.1 m high, 55 poses", 55, {0.5, 0.4, 1.1}, 0.3, 2024},
-                        {"G: circle of 0.6 m about (-0.2, -0.5), camera 0.9 m high, 48 poses", 48, {-0.2, -0.5, 0.9}, 0.6, 3131}};
-  const size_t tour_count = quick ? 1 : sizeof(tours) / sizeof(tours[0]);
+  const std::vector<TourPath> tours = otherTourPaths();
+  const size_t tour_count = quick ? 1 : tours.size();
   const int stride = 3;
   OtherToursExperiment result;
   result.with_pcl = !quick;
   for (size_t i = 0; i < tour_count; ++i)
   {
-    const Tour& tour = tours[i];
+    const TourPath& tour = tours[i];
     std::fprintf(stderr, "  other tours: %s\n", tour.name);
     OtherTour row;
     row.name = tour.name;
@@ -302,9 +290,9 @@ std::vector<StageRow> runStageAndForgettingTours(bool quick)
     std::fprintf(stderr, "  windows' fit: %s\n", named.name);
     StageRow row;
     row.scene = named.name;
-    row.windows = runTour(named.scene, roomTour(frames), 11000, stride, false, causes, 0).ours;
-    row.regions = runTour(named.scene, roomTour(frames), 11000, stride, false, causes, 1).ours;
-    row.thinning = runTour(named.scene, roomTour(frames), 11000, stride, false, causes, 1, kForgetByThinning).ours;
+    row.windows = runTour(named.scene, roomTour(frames), kRoomTourSeed, stride, false, causes, 0).ours;
+    row.regions = runTour(named.scene, roomTour(frames), kRoomTourSeed, stride, false, causes, 1).ours;
+    row.thinning = runTour(named.scene, roomTour(frames), kRoomTourSeed, stride, false, causes, 1, kForgetByThinning).ours;
     rows.push_back(row);
   }
   return rows;

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "hough_plane_detector/core/detected_plane.h"
+#include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/sim/plane_metrics.h"
 #include "pcl_comparators.h"
 
@@ -23,6 +25,33 @@ constexpr int kMinVisiblePoints = 2000;  // planes smaller in a frame are neithe
 constexpr int kWarmupFrames = 3;         // our map needs global_threshold frames before it reports
 constexpr int kResolutionCount = 3;
 extern const int kResolutions[kResolutionCount];  // Fig. 7's Hough resolutions
+
+constexpr uint32_t kRoomTourSeed = 11000;  // noise seed of Table 3's tours
+constexpr uint32_t kNoiseTourSeed = 7000;  // noise seed of Fig. 6-7's office tour
+
+// Our only noise-dependent knob: the C of eq. 11 the planarity test expects.
+DetectorParams paramsFor(double noise, int resolution);
+
+// Why our detector missed a visible true plane in its last frame: the fate of the local peak
+// that matches it, or no peak at all, or a per-frame plane the map has not reported yet.
+std::string missCause(const PlaneDetector& detector, const TruePlane& truth);
+
+// Table 3's three scenes, and the other camera paths they are also toured along.
+struct NamedScene
+{
+  const char* name;
+  Scene scene;
+};
+std::vector<NamedScene> tableThreeScenes();
+struct TourPath
+{
+  const char* name;
+  int frames;
+  Eigen::Vector3d centre;
+  double radius;
+  uint32_t seed;
+};
+std::vector<TourPath> otherTourPaths();
 
 // The paper tuned RANSAC's inlier threshold to the noise: 0.01 m on clean data up to 0.05 m.
 double ransacThreshold(double noise);

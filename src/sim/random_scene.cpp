@@ -12,6 +12,8 @@ namespace hough_plane_detector
 const std::vector<uint32_t> kHeldOutSeeds = {101, 102, 103, 104, 105, 106, 107, 108, 109, 110,
                                              111, 112, 113, 114, 115, 116, 117, 118, 119, 120};
 const std::vector<uint32_t> kTuningSeeds = {901, 902, 903, 904, 905, 906, 907, 908};
+const std::vector<uint32_t> kDevelopmentSeeds = {950, 951, 952, 953, 954, 955, 956, 957,
+                                                 958, 959, 960, 961, 962, 963, 964, 965};
 
 namespace
 {

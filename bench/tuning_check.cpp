@@ -1,0 +1,195 @@
+// The rendered sets a change to the detector may be judged and tuned on, in about a minute
+// (make tuning-check): the tuning and development seeds of the procedural rooms, Table 3's
+// tours, its scenes along the other paths and Fig. 7's office at C = 4, each as one line with the
+// same scoring as make evaluate (PCL's methods left out). The held-out seeds are not here on
+// purpose: their figures come from make evaluate only, after a change is decided.
+// With --osd, the annotated real frames of osd-learn too (one frame each, PCL left out).
+// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--PARAM VALUE ...] (see --help)
+#include <cstdio>
+#include <functional>
+#include <future>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/random_scene.h"
+#include "hough_plane_detector/sim/scene_renderer.h"
+#include "hough_plane_detector/tools/cli_options.h"
+#include "osd_learn.h"
+#include "paper_experiments.h"
+
+using namespace hough_plane_detector;
+
+namespace
+{
+constexpr int kRoomFrames = 30;   // as make evaluate's procedural rooms
+constexpr int kTableThreeFrames = 60;
+constexpr int kFigureSevenFrames = 48;
+constexpr int kFigureSevenStride = 4;
+
+struct SetResult
+{
+  std::string name;
+  MethodStats stats;
+  std::map<std::string, int> causes;  // our misses by cause
+};
+
+using ParamsFor = std::function<DetectorParams(double noise)>;
+
+// One camera path through one scene: scored from kWarmupFrames on every stride-th frame.
+void runSequence(const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, double noise, uint32_t noise_seed,
+                 int stride, const DetectorParams& params, SetResult& result)
+{
+  const SceneRenderer renderer(scene);
+  PlaneDetector detector(params);
+  KinectNoise kinect;
+  kinect.coefficient = noise;
+  for (size_t f = 0; f < poses.size(); ++f)
+  {
+    const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
+    detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
+    if (static_cast<int>(f) < kWarmupFrames || (static_cast<int>(f) - kWarmupFrames) % stride != 0) continue;
+    const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
+                                               evaluatedPlanes(detector.planes()));
+    result.stats.add(metrics);
+    for (int missed : metrics.missed) ++result.causes[missCause(detector, renderer.truePlanes()[missed])];
+  }
+}
+
+SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const ParamsFor& params_for)
+{
+  SetResult result{name, {}, {}};
+  for (uint32_t seed : seeds)
+  {
+    const RandomScene room = makeRandomScene(seed, kRoomFrames);
+    // The room's own noise seeds, as make evaluate renders them.
+    runSequence(room.scene, room.poses, room.noise, seed * 1000, 3, params_for(room.noise), result);
+  }
+  return result;
+}
+
+SetResult runTableThree(const ParamsFor& params_for)
+{
+  SetResult result{"Table 3's tours", {}, {}};
+  for (const NamedScene& named : tableThreeScenes())
+    runSequence(named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, 3, params_for(1.0), result);
+  return result;
+}
+
+SetResult runOtherTours(const ParamsFor& params_for)
+{
+  SetResult result{"Table 3's scenes, other tours", {}, {}};
+  for (const TourPath& tour : otherTourPaths())
+    for (const NamedScene& named : tableThreeScenes())
+      runSequence(named.scene, roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, 3, params_for(1.0),
+                  result);
+  return result;
+}
+
+SetResult runFigureSeven(const ParamsFor& params_for)
+{
+  // As make evaluate runs Fig. 7: the paper's thinning, the office at C = 4, resolution 1024.
+  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}};
+  DetectorParams params = params_for(4.0);
+  params.forgetting = kForgetByThinning;
+  runSequence(makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kFigureSevenStride, params, result);
+  return result;
+}
+
+void print(const SetResult& r, bool causes)
+{
+  std::printf("%-32s %5.1f %% (%d/%d)  false/frame %.3f  E_angle %.4f  E_d %.4f  frames %d\n", r.name.c_str(),
+              r.stats.detectionPercent(), r.stats.detected, r.stats.visible, r.stats.falsePerFrame(), mean(r.stats.angle),
+              mean(r.stats.d), r.stats.frames);
+  if (!causes) return;
+  for (const auto& cause : r.causes) std::printf("    %4d  %s\n", cause.second, cause.first.c_str());
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  namespace po = boost::program_options;
+  std::string sets = "tuning,development,table3,other,fig7", osd_dir;
+  DetectorParams scratch;  // the flags' values are checked here, then applied to every detector
+  po::options_description options("options"), detector_options("detector parameters (applied to every run)"), hidden;
+  options.add_options()("help,h", "this help")
+      ("sets", po::value(&sets)->value_name("LIST"),
+       "comma-separated: tuning (seeds 901-908), development (950-965), table3, other, fig7 (default: all)")
+      ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
+      ("causes", "our misses of each set by what became of their candidate");
+  addDetectorParamOptions(scratch, detector_options, hidden);
+  po::options_description all;
+  all.add(options).add(detector_options).add(hidden);
+  po::variables_map values;
+  std::string error;
+  if (!parseCommandLine(argc, argv, all, po::positional_options_description(), values, &error))
+  {
+    std::cerr << "tuning_check: " << error << "\nusage: tuning_check [options] (see --help)\n";
+    return 2;
+  }
+  if (values.count("help"))
+  {
+    std::cout << "usage: tuning_check [options]\n" << options << detector_options;
+    return 0;
+  }
+  std::vector<std::pair<std::string, std::string>> overrides;
+  for (const auto& value : values)
+    if (value.first != "sets" && value.first != "causes" && value.first != "help" && value.first != "osd")
+      overrides.emplace_back(value.first, value.second.as<std::string>());
+  // Each room's sensor_noise as make evaluate sets it, then the flags given.
+  const ParamsFor params_for = [&overrides](double noise) {
+    DetectorParams params = paramsFor(noise, 1024);
+    for (const auto& o : overrides)
+    {
+      std::string name = o.first;
+      for (char& c : name)
+        if (c == '-') c = '_';
+      setDetectorParam(params, name, o.second, nullptr);  // checked when parsed
+    }
+    return params;
+  };
+  std::vector<std::function<SetResult()>> runs;
+  std::stringstream list(sets);
+  for (std::string set; std::getline(list, set, ',');)
+  {
+    if (set == "tuning")
+      runs.push_back([&] { return runRooms("tuning seeds", kTuningSeeds, params_for); });
+    else if (set == "development")
+      runs.push_back([&] { return runRooms("development seeds", kDevelopmentSeeds, params_for); });
+    else if (set == "table3")
+      runs.push_back([&] { return runTableThree(params_for); });
+    else if (set == "other")
+      runs.push_back([&] { return runOtherTours(params_for); });
+    else if (set == "fig7")
+      runs.push_back([&] { return runFigureSeven(params_for); });
+    else
+    {
+      std::cerr << "tuning_check: unknown set '" << set << "' (tuning, development, table3, other, fig7)\n";
+      return 2;
+    }
+  }
+  // The sets are independent: all at once, one thread each (a detector and its renderer per run).
+  std::vector<std::future<SetResult>> results;
+  for (const auto& run : runs) results.push_back(std::async(std::launch::async, run));
+  const bool causes = values.count("causes") > 0;
+  for (auto& result : results) print(result.get(), causes);
+  if (osd_dir.empty()) return 0;
+  OsdResults osd;
+  if (!evaluateOsdLearn(osd_dir, params_for(0.0), false, "", osd, &error))
+  {
+    std::cerr << "tuning_check: " << error << "\n";
+    return 1;
+  }
+  const OsdMethodResult& one = osd.methods.front();
+  std::printf("%-32s %5.1f %% (%d/%d)  duplicates/frame %.2f  on cans %d  E_angle %.4f  E_d %.4f  frames %d\n",
+              "osd-learn, one frame", one.foundPercent(), one.found, one.entries,
+              static_cast<double>(one.duplicates) / one.frames, one.curved_planes, mean(one.angle_errors),
+              mean(one.d_errors), one.frames);
+  if (causes)
+    for (const auto& reason : osd.misses_by_reason) std::printf("    %4d  %s\n", reason.second, reason.first.c_str());
+  return 0;
+}
