@@ -102,13 +102,14 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
     candidates.push_back({normal, d, peak.value, moments.count, verdict});
     if (verdict != CandidateVerdict::kAccepted) continue;
     const double first_sight_points = tests_.firstSightPoints(blocks);  // of the tight fit, as `moments`
+    FramePlane refined;
+    describeMeasurement(refined, blocks);
     // Claim everything within support_distance, not just the tight fit, so that leftovers
     // around an accepted plane cannot pose as a slightly tilted second one.
     for (int s : windows) claimed[s] = 1;
     for (int b : blocks) frame_.block_claim[b] = 1;
     collectPlaneBlocks(normal, d, windows, blocks, false);
     for (int b : blocks) frame_.block_claim[b] = 1;
-    FramePlane refined;
     refined.normal = normal;
     refined.d = d;
     refined.hough = param_.toHough(normal, d);
@@ -240,7 +241,22 @@ FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d
   plane.parallel = parallel;
   plane.first_sight_points = tests_.firstSightPoints(blocks);
   plane.blocks = blocks;
+  describeMeasurement(plane, blocks);
   return plane;
+}
+
+void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const
+{
+  PointMoments points;
+  double information = 0.0;  // of the offset: the blocks' inverse centroid variances
+  for (int b : blocks)
+  {
+    points.add(frame_.moments(b));
+    information += 1.0 / (frame_.blocks[b].centroid_variance + kCentroidFloor);
+  }
+  if (!(points.count > 0.0)) return;
+  plane.centroid = frame_.camera_to_world * points.mean();
+  plane.offset_sigma = std::sqrt(1.0 / information + kCentroidFloor);
 }
 
 void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const
@@ -387,6 +403,9 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // off an older box's would take its direction. Judged on the interior: rim blocks straddling
   // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
   if (!tests_.explainedByNormal(n_cam, inliers)) return false;
+  // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
+  // explains the face, its own normal is the better model, when the points determine it.
+  if (!tests_.explainedByNormal(n_cam, inliers, true) && normalDetermined(inliers)) return false;
   normal = known;
   d = frame_.dInWorld(known, d_cam);
   return true;

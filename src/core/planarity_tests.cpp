@@ -193,11 +193,24 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
   return moments;
 }
 
-bool PlanarityTests::explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+bool PlanarityTests::explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks,
+                                       bool oriented_rim) const
 {
-  std::vector<int> interior = interiorBlocks(blocks, frame_.normals.blocksX(), frame_.normals.blocksY());
-  if (interior.size() < kMinInteriorBlocks) interior = blocks;
-  return snapChi2Increase(n_cam, interior) <= kMaxSnapChi2Increase;
+  std::vector<int> tested = interiorBlocks(blocks, frame_.normals.blocksX(), frame_.normals.blocksY());
+  if (tested.size() < kMinInteriorBlocks) return snapChi2Increase(n_cam, blocks) <= kMaxSnapChi2Increase;
+  if (oriented_rim)
+  {
+    std::vector<int> interior = tested;
+    std::sort(interior.begin(), interior.end());
+    for (int b : blocks)
+    {
+      const BlockInfo& info = frame_.blocks[b];
+      if (info.normal_tolerance < M_PI / 2 && std::abs(info.normal.dot(n_cam)) >= info.normal_tolerance_cosine &&
+          !std::binary_search(interior.begin(), interior.end(), b))
+        tested.push_back(b);
+    }
+  }
+  return snapChi2Increase(n_cam, tested) <= kMaxSnapChi2Increase;
 }
 
 double PlanarityTests::snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const

@@ -9,6 +9,13 @@
 namespace hough_plane_detector
 {
 
+namespace
+{
+// How far a real face may depart from its plane: box tops domed by 1-2 mm, one face grown as
+// two regions 5 mm apart (osd-learn).
+constexpr double kSurfaceWarp = 0.005;
+}  // namespace
+
 PlaneMap::PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
                    const HoughPeakSearch& peak_search)
   : params_(params)
@@ -86,8 +93,8 @@ bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::
     return unsignedAngle(normal, peak.normal) / params_.merge_angle +
            std::abs(sign * d - peak.d) / params_.merge_distance;
   };
-  // Planes of one list, one nearer each peak, that eq. 7-8 would not merge themselves.
-  auto apart = [&](const auto& planes, bool need_dissimilar) {
+  // Planes of one list, one nearer each peak, that are two surfaces themselves.
+  auto apart = [&](const auto& planes, const auto& two_surfaces) {
     for (const auto& near_a : planes)
     {
       const double a_to_a = cost(near_a.normal, near_a.d, a);
@@ -96,15 +103,28 @@ bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::
       {
         const double b_to_b = cost(near_b.normal, near_b.d, b);
         if (b_to_b > 1.0 || b_to_b >= cost(near_b.normal, near_b.d, a)) continue;
-        if (!need_dissimilar ||
-            !withinMergeTolerances(near_a.normal, near_a.d, near_b.normal, near_b.d, params_.merge_angle,
-                                   params_.merge_distance))
-          return true;
+        if (two_surfaces(near_a, near_b)) return true;
       }
     }
     return false;
   };
-  return apart(frame_planes, true) || apart(planes_, false);
+  return apart(frame_planes, [&](const FramePlane& x, const FramePlane& y) { return distinctSurfaces(x, y); }) ||
+         apart(planes_, [](const DetectedPlane&, const DetectedPlane&) { return true; });
+}
+
+bool PlaneMap::distinctSurfaces(const FramePlane& a, const FramePlane& b) const
+{
+  if (!withinMergeTolerances(a.normal, a.d, b.normal, b.d, params_.merge_angle, params_.merge_distance)) return true;
+  if (!(a.offset_sigma > 0.0 && b.offset_sigma > 0.0)) return false;
+  // Measured in one frame, no pose error lies between them: one surface's two regions differ
+  // by their offsets' noise, the face's warp, and their normals' difference over the distance.
+  const double sign = a.normal.dot(b.normal) >= 0.0 ? 1.0 : -1.0;
+  const Eigen::Vector3d between = b.centroid - a.centroid;
+  const double gap = std::abs((a.normal + sign * b.normal).normalized().dot(between));
+  const double allowed = 3.0 * std::sqrt(a.offset_sigma * a.offset_sigma + b.offset_sigma * b.offset_sigma +
+                                         kSurfaceWarp * kSurfaceWarp) +
+                         unsignedAngle(a.normal, b.normal) * between.norm();
+  return gap > allowed;
 }
 
 void PlaneMap::thin(float cap, const std::vector<FramePlane>& frame_planes)

@@ -51,6 +51,10 @@ struct FramePlane
   double support = 0.0;   // points of the frame on it
   bool parallel = false;  // with a known plane's normal: the parallel search's, or snapped to it
   double first_sight_points = 0.0;  // support with near points weighted by precision (strong_support)
+  // Where it was measured (world frame): its points' centroid and the standard error of its
+  // offset there; 0 when unknown (the parallel search's planes).
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  double offset_sigma = 0.0;
   std::vector<int> blocks;  // region_growing: the blocks of its region
 };
 
@@ -90,6 +94,8 @@ private:
                                    PointMoments& weighted);
   // The planarity tests of a grown region, in order; the flat components' moments in `moments`.
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
+  // Sets the plane's centroid and offset error from the blocks that measured it.
+  void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
   // A region's accepted plane (world frame) as the map receives it.
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
                          const std::vector<int>& blocks) const;

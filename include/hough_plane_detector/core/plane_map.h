@@ -76,6 +76,9 @@ private:
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
   bool measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const;
+  // True when two planes one frame measured are two surfaces: not similar by eq. 7-8, or their
+  // centroids lie farther apart along their normal than their offsets' errors and a face's warp allow.
+  bool distinctSurfaces(const FramePlane& a, const FramePlane& b) const;
   // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map.
   float voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes) const;
   // The space's peaks as the new plane list, ids carried over from the closest previous plane.
