@@ -337,7 +337,7 @@ TEST(DetectPlanesCli, TwoParallelTopsOfARealFrameAFewCentimetresApartAreTwoPlane
 TEST(DetectPlanesCli, ANearBoxTopTiltedFromTheTableKeepsItsOwnNormal)
 {
   // A 384 x 224 crop of osd-learn's learn10 (test/data/README.md): a small box's top 0.07 rad
-  // off the table's normal, 1 m away. Its interior (10 blocks) cannot tell the tilt from the
+  // off the table's normal, 1 m away. Its interior (about 10 blocks) cannot tell the tilt from the
   // table's normal; with its oriented rim blocks the table's normal no longer explains it, so
   // the top is not snapped to it (snapped it lay 3.5 cm and 0.07 rad off the annotated face).
   const RunResult r = run(std::string(HOUGH_SOURCE_DIR) + "/test/data/osd_learn10_tilted_top.pcd");

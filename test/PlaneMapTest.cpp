@@ -213,9 +213,9 @@ TEST(PlaneMap, PlanesOneFrameMeasuredApartStayApartAndASplitFaceStaysOne)
 TEST(PlaneMap, TwoSurfacesOneFrameMeasuredCloserThanTheMergeDistanceStayTwo)
 {
   // A box top and a lid 2.9 cm apart (under merge_distance 3 cm, three d cells: two maxima):
-  // eq. 7-8 alone would report one plane between them. One frame measured both, with millimetre offset errors and nothing
-  // between them but their warp: two surfaces. One face grown as two regions 5 mm and 0.03 rad
-  // apart, 30 cm from each other, stays one plane.
+  // eq. 7-8 alone would report one plane between them. One frame measured both, with
+  // millimetre offset errors and nothing between them but their warp: two surfaces. One face
+  // grown as two regions 5 mm and 0.03 rad apart, 30 cm from each other, stays one plane.
   auto measured = [](FramePlane plane, const Eigen::Vector3d& centroid) {
     plane.centroid = centroid;
     plane.offset_sigma = 0.001;
@@ -231,7 +231,7 @@ TEST(PlaneMap, TwoSurfacesOneFrameMeasuredCloserThanTheMergeDistanceStayTwo)
     for (const DetectedPlane& plane : tops.map.planes()) d.push_back(std::abs(plane.d));
     std::sort(d.begin(), d.end());
     ASSERT_EQ(d.size(), 2u) << "frame " << f;
-    // Each Gaussian's tail pulls the other's sub-voxel mean by 6-7 mm this close; the midpoint is 14.5 mm off.
+    // Each Gaussian's tail pulls the other's sub-voxel mean 6-7 mm this close (the midpoint: 14.5).
     EXPECT_NEAR(d[0], 0.500, 0.008);
     EXPECT_NEAR(d[1], 0.529, 0.008);
   }
