@@ -104,6 +104,42 @@ bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double
   return std::abs(normal.dot(i.centroid) + d) <= std::min(params_.support_distance, i.region_residual);
 }
 
+bool BlockRegionGrower::extendOverWarp(PlaneRegion& region, const std::vector<char>& taken, double max_turn)
+{
+  const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
+  PlaneRegion extended = region;
+  auto onSurface = [&](int b) {
+    const BlockInfo& i = info_[b];
+    // Only blocks that show their own orientation: a thick one at a fold would pass any normal.
+    if (!i.planar || i.normal_tolerance >= M_PI / 2 || std::abs(i.normal.dot(extended.normal)) < i.normal_tolerance_cosine)
+      return false;
+    if (std::abs(extended.normal.dot(i.centroid.normalized())) < kMinRaySine) return false;
+    // The warp adds to the block's noise as an independent error.
+    const double reach = std::sqrt(i.region_residual * i.region_residual + kSurfaceWarp * kSurfaceWarp);
+    return std::abs(extended.normal.dot(i.centroid) + extended.d) <= std::min(params_.support_distance, reach);
+  };
+  constexpr int kMaxSweeps = 3;
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep)
+  {
+    ++generation_;
+    for (int b : extended.blocks) mark_[b] = generation_;
+    const size_t before = extended.blocks.size();
+    for (size_t head = 0; head < extended.blocks.size(); ++head)
+      forEachNeighbour(extended.blocks[head], bx_count, by_count, [&](int nb) {
+        if (mark_[nb] == generation_ || taken[nb]) return;
+        mark_[nb] = generation_;
+        if (onSurface(nb)) extended.blocks.push_back(nb);
+      });
+    if (extended.blocks.size() == before || !fit(extended.blocks, extended.normal, extended.d)) break;
+  }
+  if (extended.blocks.size() == region.blocks.size()) return false;
+  if (std::acos(std::min(1.0, std::abs(extended.normal.dot(region.normal)))) > max_turn) return false;
+  extended.points = 0;
+  for (int b : extended.blocks) extended.points += grid_.block(b % bx_count, b / bx_count).count;
+  region = std::move(extended);
+  return true;
+}
+
 bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
 {
   size_t grazing = 0;

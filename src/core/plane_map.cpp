@@ -4,17 +4,11 @@
 #include <cmath>
 #include <functional>
 
+#include "hough_plane_detector/core/block_regions.h"
 #include "hough_plane_detector/core/plane_geometry.h"
 
 namespace hough_plane_detector
 {
-
-namespace
-{
-// How far a real face may depart from its plane: box tops domed by 1-2 mm, one face grown as
-// two regions 5 mm apart (osd-learn).
-constexpr double kSurfaceWarp = 0.005;
-}  // namespace
 
 PlaneMap::PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
                    const HoughPeakSearch& peak_search)

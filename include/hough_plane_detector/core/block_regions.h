@@ -23,6 +23,9 @@ constexpr double kMaxPlaneCurvature = 2.0;
 // doming 1 mm over 5 cm at 0.7 m (curvature 3/m). A can of 3.3 cm radius passes only as a
 // strip under 1.6 cm wide.
 constexpr double kMaxPlaneSag = 0.001;
+// How far a real face may depart from its plane: cardboard faces bow, panels warp (osd-learn's
+// box faces by 2-5 mm over 15 cm, one face grown as two regions 5 mm apart).
+constexpr double kSurfaceWarp = 0.005;
 
 // One block of the last frame, camera frame, with the noise limits the tests use.
 struct BlockInfo
@@ -95,6 +98,11 @@ public:
   PlaneRegion grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
   // True when the block may join a region of plane (normal, d).
   bool accepts(int block, const Eigen::Vector3d& normal, double d) const;
+  // An accepted region's plane describes its whole surface: the blocks around it (trimmed ones
+  // too) that lie on it within their noise and kSurfaceWarp join, and the plane is refitted
+  // to all of them, as a least-squares fit to the whole face would be. Returns false (region
+  // unchanged) when the refit turns the normal by more than `max_turn`.
+  bool extendOverWarp(PlaneRegion& region, const std::vector<char>& taken, double max_turn);
   // True when the rays to most of the blocks graze the plane (under ~6 deg).
   bool seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // True when the block centroids bend away from the plane: a quadric fit explains them
