@@ -93,47 +93,48 @@ BlockRegionGrower::BlockRegionGrower(const NormalEstimator& grid, const std::vec
 {
 }
 
-bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double d) const
+bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double d, double warp, bool oriented_only) const
 {
   const BlockInfo& i = info_[block];
   if (!i.planar) return false;
+  // A thick block at a fold would pass any normal; where that matters only oriented ones join.
+  if (oriented_only && i.normal_tolerance >= M_PI / 2) return false;
   if (std::abs(i.normal.dot(normal)) < i.normal_tolerance_cosine) return false;
   // Rays that graze a plane move along it with their depth error, so any surface they hit
   // lies "on" it: a plane seen edge-on cannot be tested, and no block joins it that way.
   if (std::abs(normal.dot(i.centroid.normalized())) < kMinRaySine) return false;
-  return std::abs(normal.dot(i.centroid) + d) <= std::min(params_.support_distance, i.region_residual);
+  // A face's warp adds to the block's noise as an independent error.
+  const double reach = warp > 0.0 ? std::sqrt(i.region_residual * i.region_residual + warp * warp) : i.region_residual;
+  return std::abs(normal.dot(i.centroid) + d) <= std::min(params_.support_distance, reach);
+}
+
+size_t BlockRegionGrower::sweep(std::vector<int>& blocks, const std::vector<char>& taken, const Eigen::Vector3d& normal,
+                                double d, double warp, bool oriented_only)
+{
+  const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
+  ++generation_;
+  for (int b : blocks) mark_[b] = generation_;
+  const size_t before = blocks.size();
+  for (size_t head = 0; head < blocks.size(); ++head)
+    forEachNeighbour(blocks[head], bx_count, by_count, [&](int nb) {
+      if (mark_[nb] == generation_ || taken[nb]) return;
+      mark_[nb] = generation_;
+      if (accepts(nb, normal, d, warp, oriented_only)) blocks.push_back(nb);
+    });
+  return blocks.size() - before;
 }
 
 bool BlockRegionGrower::extendOverWarp(PlaneRegion& region, const std::vector<char>& taken, double max_turn)
 {
-  const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
   PlaneRegion extended = region;
-  auto onSurface = [&](int b) {
-    const BlockInfo& i = info_[b];
-    // Only blocks that show their own orientation: a thick one at a fold would pass any normal.
-    if (!i.planar || i.normal_tolerance >= M_PI / 2 || std::abs(i.normal.dot(extended.normal)) < i.normal_tolerance_cosine)
-      return false;
-    if (std::abs(extended.normal.dot(i.centroid.normalized())) < kMinRaySine) return false;
-    // The warp adds to the block's noise as an independent error.
-    const double reach = std::sqrt(i.region_residual * i.region_residual + kSurfaceWarp * kSurfaceWarp);
-    return std::abs(extended.normal.dot(i.centroid) + extended.d) <= std::min(params_.support_distance, reach);
-  };
   constexpr int kMaxSweeps = 3;
-  for (int sweep = 0; sweep < kMaxSweeps; ++sweep)
-  {
-    ++generation_;
-    for (int b : extended.blocks) mark_[b] = generation_;
-    const size_t before = extended.blocks.size();
-    for (size_t head = 0; head < extended.blocks.size(); ++head)
-      forEachNeighbour(extended.blocks[head], bx_count, by_count, [&](int nb) {
-        if (mark_[nb] == generation_ || taken[nb]) return;
-        mark_[nb] = generation_;
-        if (onSurface(nb)) extended.blocks.push_back(nb);
-      });
-    if (extended.blocks.size() == before || !fit(extended.blocks, extended.normal, extended.d)) break;
-  }
+  for (int s = 0; s < kMaxSweeps; ++s)
+    if (sweep(extended.blocks, taken, extended.normal, extended.d, kSurfaceWarp, true) == 0 ||
+        !fit(extended.blocks, extended.normal, extended.d))
+      break;
   if (extended.blocks.size() == region.blocks.size()) return false;
   if (std::acos(std::min(1.0, std::abs(extended.normal.dot(region.normal)))) > max_turn) return false;
+  const int bx_count = grid_.blocksX();
   extended.points = 0;
   for (int b : extended.blocks) extended.points += grid_.block(b % bx_count, b / bx_count).count;
   region = std::move(extended);
@@ -326,7 +327,7 @@ std::vector<std::vector<int>> BlockRegionGrower::seedComponents(const Eigen::Vec
 PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d,
                                     const std::vector<char>& taken)
 {
-  const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
+  const int bx_count = grid_.blocksX();
   PlaneRegion region;
   region.normal = normal;
   region.d = d;
@@ -335,18 +336,9 @@ PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::V
   // Each sweep grows from the whole region against the last fit; a better plane may admit
   // blocks the first guess refused (and keep those it no longer would: they were on it).
   constexpr int kMaxSweeps = 4;
-  for (int sweep = 0; sweep < kMaxSweeps; ++sweep)
+  for (int s = 0; s < kMaxSweeps; ++s)
   {
-    ++generation_;
-    for (int b : region.blocks) mark_[b] = generation_;
-    const size_t before = region.blocks.size();
-    for (size_t head = 0; head < region.blocks.size(); ++head)
-      forEachNeighbour(region.blocks[head], bx_count, by_count, [&](int nb) {
-        if (mark_[nb] == generation_ || taken[nb]) return;
-        mark_[nb] = generation_;
-        if (accepts(nb, region.normal, region.d)) region.blocks.push_back(nb);
-      });
-    const bool grew = region.blocks.size() > before;
+    const bool grew = sweep(region.blocks, taken, region.normal, region.d) > 0;
     fit(region.blocks, region.normal, region.d);
     if (!grew) break;
   }

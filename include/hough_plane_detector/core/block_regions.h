@@ -96,8 +96,10 @@ public:
   // plane after each sweep, until nothing more joins; then trims blocks beyond two sigmas of
   // the interior's plane (into `trimmed`) and fits the plane to what is left.
   PlaneRegion grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d, const std::vector<char>& taken);
-  // True when the block may join a region of plane (normal, d).
-  bool accepts(int block, const Eigen::Vector3d& normal, double d) const;
+  // True when the block may join a region of plane (normal, d): flat, its normal agreeing, its
+  // centroid within its noise (and `warp` more). `oriented_only`: blocks without a usable normal
+  // of their own stay out.
+  bool accepts(int block, const Eigen::Vector3d& normal, double d, double warp = 0.0, bool oriented_only = false) const;
   // An accepted region's plane describes its whole surface: the blocks around it (trimmed ones
   // too) that lie on it within their noise and kSurfaceWarp join, and the plane is refitted
   // to all of them, as a least-squares fit to the whole face would be. Returns false (region
@@ -120,6 +122,11 @@ public:
   bool fitInterior(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
 
 private:
+  // One breadth-first sweep from `blocks` over neighbours not taken that accepts() admits;
+  // returns how many joined.
+  size_t sweep(std::vector<int>& blocks, const std::vector<char>& taken, const Eigen::Vector3d& normal, double d,
+               double warp = 0.0, bool oriented_only = false);
+
   const NormalEstimator& grid_;
   const std::vector<BlockInfo>& info_;
   const DetectorParams& params_;
