@@ -134,9 +134,6 @@ bool BlockRegionGrower::extendOverWarp(PlaneRegion& region, const std::vector<ch
       break;
   if (extended.blocks.size() == region.blocks.size()) return false;
   if (std::acos(std::min(1.0, std::abs(extended.normal.dot(region.normal)))) > max_turn) return false;
-  const int bx_count = grid_.blocksX();
-  extended.points = 0;
-  for (int b : extended.blocks) extended.points += grid_.block(b % bx_count, b / bx_count).count;
   region = std::move(extended);
   return true;
 }

@@ -411,10 +411,11 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // likelihood-ratio test (2 degrees of freedom, the normal's), else a box face a few degrees
   // off an older box's would take its direction. Judged on the interior: rim blocks straddling
   // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
-  if (!tests_.explainedByNormal(n_cam, inliers)) return false;
+  const PlanarityTests::NormalExplanation explained = tests_.explainNormal(n_cam, inliers, true);
+  if (!explained.interior) return false;
   // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
   // explains the face, its own normal is the better model, when the points determine it.
-  if (!tests_.explainedByNormal(n_cam, inliers, true) && normalDetermined(inliers)) return false;
+  if (!explained.with_oriented_rim && normalDetermined(inliers)) return false;
   normal = known;
   d = frame_.dInWorld(known, d_cam);
   return true;

@@ -193,24 +193,30 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
   return moments;
 }
 
-bool PlanarityTests::explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks,
-                                       bool oriented_rim) const
+PlanarityTests::NormalExplanation PlanarityTests::explainNormal(const Eigen::Vector3d& n_cam,
+                                                               const std::vector<int>& blocks, bool with_rim) const
 {
+  NormalExplanation verdict;
   std::vector<int> tested = interiorBlocks(blocks, frame_.normals.blocksX(), frame_.normals.blocksY());
-  if (tested.size() < kMinInteriorBlocks) return snapChi2Increase(n_cam, blocks) <= kMaxSnapChi2Increase;
-  if (oriented_rim)
+  if (tested.size() < kMinInteriorBlocks)
   {
-    std::vector<int> interior = tested;
-    std::sort(interior.begin(), interior.end());
-    for (int b : blocks)
-    {
-      const BlockInfo& info = frame_.blocks[b];
-      if (info.normal_tolerance < M_PI / 2 && std::abs(info.normal.dot(n_cam)) >= info.normal_tolerance_cosine &&
-          !std::binary_search(interior.begin(), interior.end(), b))
-        tested.push_back(b);
-    }
+    // No interior to tell from the rim: all blocks are tested, once for both verdicts.
+    verdict.interior = verdict.with_oriented_rim = snapChi2Increase(n_cam, blocks) <= kMaxSnapChi2Increase;
+    return verdict;
   }
-  return snapChi2Increase(n_cam, tested) <= kMaxSnapChi2Increase;
+  verdict.interior = snapChi2Increase(n_cam, tested) <= kMaxSnapChi2Increase;
+  if (!with_rim || !verdict.interior) return verdict;
+  std::vector<int> interior = tested;
+  std::sort(interior.begin(), interior.end());
+  for (int b : blocks)
+  {
+    const BlockInfo& info = frame_.blocks[b];
+    if (info.normal_tolerance < M_PI / 2 && std::abs(info.normal.dot(n_cam)) >= info.normal_tolerance_cosine &&
+        !std::binary_search(interior.begin(), interior.end(), b))
+      tested.push_back(b);
+  }
+  verdict.with_oriented_rim = snapChi2Increase(n_cam, tested) <= kMaxSnapChi2Increase;
+  return verdict;
 }
 
 double PlanarityTests::snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const

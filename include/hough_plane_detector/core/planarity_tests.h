@@ -37,10 +37,20 @@ public:
                                   const std::function<bool(const std::vector<int>&)>& also = nullptr) const;
   // True when a plane of the camera-frame normal explains the blocks (their interior when it
   // has kMinInteriorBlocks: rim blocks may straddle a fold) about as well as their own best
-  // plane: a likelihood-ratio test, chi^2 increase below kMaxSnapChi2Increase. With
-  // `oriented_rim`, rim blocks count too whose own normal is informative and within its
-  // tolerance of the plane's: one straddling a fold would show the fold in its normal.
-  bool explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks, bool oriented_rim = false) const;
+  // plane: a likelihood-ratio test, chi^2 increase below kMaxSnapChi2Increase.
+  bool explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+  {
+    return explainNormal(n_cam, blocks, false).interior;
+  }
+  // The same test, and (`with_rim`, only when the interior passes) made again with the rim
+  // blocks whose own normal is informative and within its tolerance of the plane's: one
+  // straddling a fold would show the fold in its normal.
+  struct NormalExplanation
+  {
+    bool interior = false;
+    bool with_oriented_rim = false;
+  };
+  NormalExplanation explainNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks, bool with_rim) const;
   // How much more chi^2 the block centroids have about their best plane of the camera-frame
   // normal than about their own best plane (both with the centroids' noise).
   double snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const;
