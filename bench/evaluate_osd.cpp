@@ -1,5 +1,5 @@
 // The osd-learn section of make evaluate on its own, for quick checks while changing the
-// detector: evaluate_osd DIR [--no-pcl] [--misses] [--pictures OUT_DIR] [--PARAM VALUE ...]
+// detector: evaluate_osd DIR [--no-pcl] [--misses] [--errors] [--pictures OUT_DIR] [--PARAM VALUE ...]
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -18,6 +18,7 @@ int main(int argc, char** argv)
   options.add_options()("help,h", "this help")
       ("no-pcl", "skip PCL RANSAC and OMPS")
       ("misses", "list every missed entry with what became of its candidate")
+      ("errors", "list every found entry's normal error beside that of the least-squares plane of our labelled pixels")
       ("pictures", po::value(&picture_dir)->value_name("OUT_DIR"), "write segmented pictures of a few frames there");
   addDetectorParamOptions(params, detector_options, hidden);
   hidden.add_options()("dir", po::value(&dir));
@@ -49,5 +50,6 @@ int main(int argc, char** argv)
   std::string md = osdLearnMarkdown(results, "");
   if (!misses) md = md.substr(0, md.find("| frame | entry"));
   std::cout << md;
+  if (values.count("errors")) std::cout << "\n" << osdFitErrorsMarkdown(results);
   return 0;
 }

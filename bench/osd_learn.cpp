@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 
+#include <Eigen/Eigenvalues>
 #include <nlohmann/json.hpp>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
@@ -34,6 +35,7 @@ struct Entry
   double d;
   int points;
   int object;  // 0 for the table, else the object's label / 10 (obj20 -> 2)
+  int box[4];  // x0, y0, x1, y1 of its pixels
 };
 
 bool matches(const Eigen::Vector3d& n, double d, const Entry& e, double* angle = nullptr, double* distance = nullptr)
@@ -130,6 +132,58 @@ std::string missReason(const PlaneDetector& detector, const Entry& entry)
   if (nearest->verdict == CandidateVerdict::kAccepted)
     return nearest_cost <= 2.0 && nearest_cost > 1.0 ? "accepted, fitted beyond the tolerance" : "accepted, not in the map";
   return reason;
+}
+
+// For each found entry: our matching plane's error and that of the least-squares plane of
+// the pixels we label with it (the table anywhere, a face inside its box with a margin).
+void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::PointCloud<pcl::PointXYZRGBL>& cloud,
+               const std::string& frame, const std::vector<Entry>& entries, const std::vector<bool>& found,
+               std::vector<OsdFitError>& out)
+{
+  constexpr int kMargin = 10;  // px: a face's labelled pixels may reach a little past its annotated box
+  std::vector<int> labels;
+  detector.labelPixels(view, labels);
+  for (size_t i = 0; i < entries.size(); ++i)
+  {
+    if (!found[i]) continue;
+    const Entry& e = entries[i];
+    const DetectedPlane* best = nullptr;
+    double best_cost = 1e9, a, dd;
+    for (const DetectedPlane& p : detector.planes())
+      if (matches(p.normal, p.d, e, &a, &dd) && a / kMatchAngle + dd / kMatchDistance < best_cost)
+      {
+        best_cost = a / kMatchAngle + dd / kMatchDistance;
+        best = &p;
+      }
+    if (!best) continue;
+    int labelled = 0;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d squares = Eigen::Matrix3d::Zero();
+    for (int v = 0; v < view.height; ++v)
+      for (int u = 0; u < view.width; ++u)
+      {
+        const pcl::PointXYZRGBL& q = cloud.at(u, v);
+        const bool inside = e.object == 0 || (u >= e.box[0] - kMargin && u <= e.box[2] + kMargin &&
+                                              v >= e.box[1] - kMargin && v <= e.box[3] + kMargin);
+        if (inside && std::isfinite(q.z) && labels[static_cast<size_t>(v) * view.width + u] == best->id)
+        {
+          const Eigen::Vector3d x(q.x, q.y, q.z);
+          ++labelled;
+          sum += x;
+          squares += x * x.transpose();
+        }
+      }
+    OsdFitError fit{frame, e.name, e.points, labelled};
+    matches(best->normal, best->d, e, &fit.angle);
+    fit.labelled_fit_angle = M_PI / 2;
+    if (labelled >= 3)
+    {
+      const Eigen::Vector3d mean = sum / labelled;
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(squares / labelled - mean * mean.transpose());
+      fit.labelled_fit_angle = std::acos(std::min(1.0, std::abs(solver.eigenvectors().col(0).dot(e.normal))));
+    }
+    out.push_back(fit);
+  }
 }
 
 // Objects of a curved-object frame with no annotated face: cans and mugs.
@@ -231,7 +285,9 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
     {
       Entry entry{e["name"].get<std::string>(),
                   Eigen::Vector3d(e["normal"][0].get<double>(), e["normal"][1].get<double>(), e["normal"][2].get<double>()),
-                  e["d"].get<double>(), e["points"].get<int>(), 0};
+                  e["d"].get<double>(), e["points"].get<int>(), 0, {0, 0, -1, -1}};
+      if (e.contains("bbox"))
+        for (int k = 0; k < 4; ++k) entry.box[k] = e["bbox"][k].get<int>();
       if (entry.name.rfind("obj", 0) == 0) entry.object = std::stoi(entry.name.substr(3, 2)) / 10;
       entries.push_back(entry);
     }
@@ -263,6 +319,7 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
           ++results.misses_by_reason[miss.reason];
           results.misses.push_back(miss);
         }
+      fitErrors(detector, view, cloud, name, entries, found, results.fit_errors);
       if (index >= kFirstCurvedFrame)
         single.curved_planes += planesOnCurvedObjects(detector, view, cloud, curvedObjects(cloud, entries));
       if (!picture_dir.empty() && picture_frames.count(name))
@@ -329,6 +386,24 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
     md += "![" + file + "](" + picture_prefix + file + ") ";
   }
   md += "\n\n";
+  return md;
+}
+
+std::string osdFitErrorsMarkdown(const OsdResults& results)
+{
+  std::vector<OsdFitError> sorted = results.fit_errors;
+  std::sort(sorted.begin(), sorted.end(), [](const OsdFitError& a, const OsdFitError& b) { return a.angle > b.angle; });
+  std::string md = "| frame | entry | points | E_angle ours (rad) | E_angle of the LSQ plane of our labelled pixels | "
+                   "those pixels |\n|---|---|---|---|---|---|\n";
+  char line[256];
+  for (const OsdFitError& f : sorted)
+  {
+    char own[32] = "-";  // the matching plane labels no pixel near the face
+    if (f.labelled >= 3) std::snprintf(own, sizeof(own), "%.4f", f.labelled_fit_angle);
+    std::snprintf(line, sizeof(line), "| %s | %s | %d | %.4f | %s | %d |\n", f.frame.c_str(), f.entry.c_str(), f.points,
+                  f.angle, own, f.labelled);
+    md += line;
+  }
   return md;
 }
 

@@ -36,11 +36,25 @@ struct OsdMiss
   std::string reason;  // what became of its candidate in our detector
 };
 
+// A found entry's normal error (one frame), beside that of the least-squares plane of the
+// pixels our detector labels with the matching plane (inside the entry's box, 10 px margin):
+// a large first with a small second means the plane's points were right and its normal was
+// not (a known normal taken, a part of the face fitted).
+struct OsdFitError
+{
+  std::string frame, entry;
+  int points = 0;
+  int labelled = 0;                // our labelled pixels the second fit used
+  double angle = 0.0;              // ours against the annotation (rad)
+  double labelled_fit_angle = 0.0;  // least squares of our labelled pixels against the annotation
+};
+
 struct OsdResults
 {
   std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
   std::vector<OsdMiss> misses;           // ours, single frame
   std::map<std::string, int> misses_by_reason;
+  std::vector<OsdFitError> fit_errors;   // ours, single frame, every found entry
   std::vector<std::string> pictures;     // segmented frames written (PNG paths)
 };
 
@@ -57,5 +71,7 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
 
 // The Markdown section of RESULTS.md for these results.
 std::string osdLearnMarkdown(const OsdResults& results, const std::string& picture_prefix);
+// A Markdown table of results.fit_errors, largest error first.
+std::string osdFitErrorsMarkdown(const OsdResults& results);
 
 }  // namespace hough_plane_detector
