@@ -39,10 +39,10 @@ int main(int argc, char** argv)
     std::cout << "usage: evaluate_osd DIR [options]\n" << options << detector_options;
     return 0;
   }
-  const bool with_pcl = !values.count("no-pcl"), misses = values.count("misses") > 0;
+  const bool with_pcl = !values.count("no-pcl"), misses = values.count("misses") > 0, errors = values.count("errors") > 0;
   OsdResults results;
   std::string error;
-  if (!evaluateOsdLearn(dir, params, with_pcl, picture_dir, results, &error))
+  if (!evaluateOsdLearn(dir, params, with_pcl, errors, picture_dir, results, &error))
   {
     std::cerr << "evaluate_osd: " << error << "\n";
     return 1;
@@ -50,6 +50,6 @@ int main(int argc, char** argv)
   std::string md = osdLearnMarkdown(results, "");
   if (!misses) md = md.substr(0, md.find("| frame | entry"));
   std::cout << md;
-  if (values.count("errors")) std::cout << "\n" << osdFitErrorsMarkdown(results);
+  if (errors) std::cout << "\n" << osdFitErrorsMarkdown(results);
   return 0;
 }

@@ -511,7 +511,7 @@ int main(int argc, char** argv)
     std::fprintf(stderr, "osd-learn: real frames with annotated planes\n");
     OsdResults results;
     std::string error;
-    if (!evaluateOsdLearn(osd_dir, DetectorParams(), true, report.picturesDir(), results, &error))
+    if (!evaluateOsdLearn(osd_dir, DetectorParams(), true, false, report.picturesDir(), results, &error))
     {
       std::fprintf(stderr, "osd-learn: %s\n", error.c_str());
       return 1;

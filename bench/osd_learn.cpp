@@ -249,7 +249,7 @@ bool writeSegmentedPicture(const std::string& path, const PlaneDetector& detecto
   return writePng(path, view.width, view.height, rgb, error);
 }
 
-bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool with_pcl,
+bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool with_pcl, bool with_fit_errors,
                       const std::string& picture_dir, OsdResults& results, std::string* error)
 {
   nlohmann::json annotations;
@@ -319,7 +319,7 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
           ++results.misses_by_reason[miss.reason];
           results.misses.push_back(miss);
         }
-      fitErrors(detector, view, cloud, name, entries, found, results.fit_errors);
+      if (with_fit_errors) fitErrors(detector, view, cloud, name, entries, found, results.fit_errors);
       if (index >= kFirstCurvedFrame)
         single.curved_planes += planesOnCurvedObjects(detector, view, cloud, curvedObjects(cloud, entries));
       if (!picture_dir.empty() && picture_frames.count(name))

@@ -54,7 +54,7 @@ struct OsdResults
   std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
   std::vector<OsdMiss> misses;           // ours, single frame
   std::map<std::string, int> misses_by_reason;
-  std::vector<OsdFitError> fit_errors;   // ours, single frame, every found entry
+  std::vector<OsdFitError> fit_errors;   // ours, single frame, every found entry (when asked for)
   std::vector<std::string> pictures;     // segmented frames written (PNG paths)
 };
 
@@ -64,9 +64,9 @@ bool writeSegmentedPicture(const std::string& path, const PlaneDetector& detecto
                            std::string* error);
 
 // Runs the data set in `dir` (annotations.json beside learn*.pcd). `with_pcl` adds the two PCL
-// methods; `picture_dir`, when not empty, receives a few segmented frames as PNG. Returns false
-// with `error` set when the data cannot be read.
-bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool with_pcl,
+// methods, `with_fit_errors` fills results.fit_errors; `picture_dir`, when not empty, receives
+// a few segmented frames as PNG. Returns false with `error` set when the data cannot be read.
+bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool with_pcl, bool with_fit_errors,
                       const std::string& picture_dir, OsdResults& results, std::string* error);
 
 // The Markdown section of RESULTS.md for these results.

@@ -179,7 +179,7 @@ int main(int argc, char** argv)
   for (auto& result : results) print(result.get(), causes);
   if (osd_dir.empty()) return 0;
   OsdResults osd;
-  if (!evaluateOsdLearn(osd_dir, params_for(0.0), false, "", osd, &error))
+  if (!evaluateOsdLearn(osd_dir, params_for(0.0), false, false, "", osd, &error))
   {
     std::cerr << "tuning_check: " << error << "\n";
     return 1;

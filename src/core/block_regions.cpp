@@ -124,17 +124,19 @@ size_t BlockRegionGrower::sweep(std::vector<int>& blocks, const std::vector<char
   return blocks.size() - before;
 }
 
-bool BlockRegionGrower::extendOverWarp(PlaneRegion& region, const std::vector<char>& taken, double max_turn)
+bool BlockRegionGrower::wholeFacePlane(const PlaneRegion& region, const std::vector<char>& taken, double max_turn,
+                                       Eigen::Vector3d& normal, double& d)
 {
-  PlaneRegion extended = region;
+  std::vector<int> blocks = region.blocks;
+  Eigen::Vector3d face_normal = region.normal;
+  double face_d = region.d;
   constexpr int kMaxSweeps = 3;
   for (int s = 0; s < kMaxSweeps; ++s)
-    if (sweep(extended.blocks, taken, extended.normal, extended.d, kSurfaceWarp, true) == 0 ||
-        !fit(extended.blocks, extended.normal, extended.d))
-      break;
-  if (extended.blocks.size() == region.blocks.size()) return false;
-  if (std::acos(std::min(1.0, std::abs(extended.normal.dot(region.normal)))) > max_turn) return false;
-  region = std::move(extended);
+    if (sweep(blocks, taken, face_normal, face_d, kSurfaceWarp, true) == 0 || !fit(blocks, face_normal, face_d)) break;
+  if (blocks.size() == region.blocks.size()) return false;
+  if (std::acos(std::min(1.0, std::abs(face_normal.dot(region.normal)))) > max_turn) return false;
+  normal = face_normal;
+  d = face_d;
   return true;
 }
 

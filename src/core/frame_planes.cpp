@@ -187,12 +187,8 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     // The plane of the whole face, bowed edges included, as a least-squares fit to it would be.
     // The region keeps the blocks it was tested on: claiming the bowed edges too moved later
     // regions' seeds and added false planes on rendered scenes.
-    PlaneRegion whole_face = region;
-    if (verdict == CandidateVerdict::kAccepted && grower.extendOverWarp(whole_face, frame_.block_claim, params_.merge_angle))
-    {
-      region.normal = whole_face.normal;
-      region.d = whole_face.d;
-    }
+    if (verdict == CandidateVerdict::kAccepted)
+      grower.wholeFacePlane(region, frame_.block_claim, params_.merge_angle, region.normal, region.d);
     Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
     double d = frame_.dInWorld(normal, region.d);
     const bool snapped =

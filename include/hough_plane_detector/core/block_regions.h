@@ -100,11 +100,13 @@ public:
   // centroid within its noise (and `warp` more). `oriented_only`: blocks without a usable normal
   // of their own stay out.
   bool accepts(int block, const Eigen::Vector3d& normal, double d, double warp = 0.0, bool oriented_only = false) const;
-  // An accepted region's plane describes its whole surface: the blocks around it (trimmed ones
-  // too) that lie on it within their noise and kSurfaceWarp join, and the plane is refitted
-  // to all of them, as a least-squares fit to the whole face would be (`points` is left as it
-  // was). Returns false (region unchanged) when the refit turns the normal by more than `max_turn`.
-  bool extendOverWarp(PlaneRegion& region, const std::vector<char>& taken, double max_turn);
+  // The plane of an accepted region's whole surface: the blocks around it (trimmed ones too)
+  // that lie on it within their noise and kSurfaceWarp join a copy of its blocks, and the plane
+  // is refitted to all of them, as a least-squares fit to the whole face would be. Sets
+  // (normal, d) and returns true unless nothing joined or the refit turns the normal by more
+  // than `max_turn`. The region itself is not changed.
+  bool wholeFacePlane(const PlaneRegion& region, const std::vector<char>& taken, double max_turn,
+                      Eigen::Vector3d& normal, double& d);
   // True when the rays to most of the blocks graze the plane (under ~6 deg).
   bool seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // True when the block centroids bend away from the plane: a quadric fit explains them
