@@ -158,22 +158,8 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
     }
   }
   if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
-  // A region whose blocks pass the noise tests of a plane (FramePlane::fits_its_blocks) is a
-  // complete measurement of a new surface whatever its size: one frame reports it. Near a
-  // known plane it may be that plane measured badly, and waits for a second frame.
-  if (plane.fits_its_blocks && !nearKnownPlane(plane)) return 2.0f;
   const double bar = plane.parallel ? 0.25 * strong_support : strong_support;
   return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
-}
-
-bool PlaneMap::nearKnownPlane(const FramePlane& measured) const
-{
-  constexpr double kNearTolerances = 3.0;  // beyond the merge, where a noisy re-measurement still falls
-  for (const DetectedPlane& known : planes_)
-    if (withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, kNearTolerances * params_.merge_angle,
-                              kNearTolerances * params_.merge_distance))
-      return true;
-  return false;
 }
 
 bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured) const

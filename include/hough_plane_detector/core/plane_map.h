@@ -72,9 +72,6 @@ private:
   void thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes);
   // True when the frame's plane lies on the map's within the merge tolerances (either side).
   bool samePlane(const DetectedPlane& known, const FramePlane& measured) const;
-  // True when a map plane lies within three merge tolerances of the frame's plane: more likely
-  // a noisy re-measurement of it than a new surface, so it is not reported at first sight.
-  bool nearKnownPlane(const FramePlane& measured) const;
   // True when one of this frame's planes lies on `plane` within the merge tolerances.
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
