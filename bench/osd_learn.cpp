@@ -13,6 +13,7 @@
 #include <pcl/point_types.h>
 
 #include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/core/plane_geometry.h"
 #include "hough_plane_detector/tools/png_image.h"
 #include "pcl_comparators.h"
 #include "stopwatch.h"
@@ -180,7 +181,7 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
     {
       const Eigen::Vector3d mean = sum / labelled;
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(squares / labelled - mean * mean.transpose());
-      fit.labelled_fit_angle = std::acos(std::min(1.0, std::abs(solver.eigenvectors().col(0).dot(e.normal))));
+      fit.labelled_fit_angle = unsignedAngle(solver.eigenvectors().col(0), e.normal);
     }
     out.push_back(fit);
   }

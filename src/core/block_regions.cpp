@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "hough_plane_detector/core/plane_geometry.h"
 #include "hough_plane_detector/core/symmetric_eigen.h"
 
 namespace hough_plane_detector
@@ -134,7 +135,7 @@ bool BlockRegionGrower::wholeFacePlane(const PlaneRegion& region, const std::vec
   for (int s = 0; s < kMaxSweeps; ++s)
     if (sweep(blocks, taken, face_normal, face_d, kSurfaceWarp, true) == 0 || !fit(blocks, face_normal, face_d)) break;
   if (blocks.size() == region.blocks.size()) return false;
-  if (std::acos(std::min(1.0, std::abs(face_normal.dot(region.normal)))) > max_turn) return false;
+  if (unsignedAngle(face_normal, region.normal) > max_turn) return false;
   normal = face_normal;
   d = face_d;
   return true;
