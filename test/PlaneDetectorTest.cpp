@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "hough_plane_detector/core/plane_detector.h"
+#include "hough_plane_detector/core/plane_geometry.h"
 #include "hough_plane_detector/sim/plane_metrics.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/core/sensor_model.h"
@@ -174,6 +175,65 @@ TEST(PlaneDetector, AStronglySupportedPlaneIsReportedAtFirstSight)
     feed(detector, second, 0.1);
     EXPECT_EQ(matching(detector.planes(), kX, -3.0, 0.01, 0.02).size(), 1u) << describe(detector.planes());
     EXPECT_EQ(matching(detector.planes(), panel_normal, panel_d, 0.02, 0.02).size(), 1u) << describe(detector.planes());
+  }
+}
+
+// The first-sight test of a region (FramePlane::fits_its_blocks): a flat panel 2 m away
+// passes it; the same panel folded by 5 deg along its middle is grown as one region (its two
+// halves agree within merge_angle) but its blocks bow off the fitted plane beyond their noise.
+TEST(PlaneDetector, AFoldedPanelDoesNotFitItsBlocks)
+{
+  for (double fold : {0.0, 5.0 * M_PI / 180.0})
+  {
+    Scene scene;
+    scene.addRectangle({3.0, 0, 1.0}, kY, kZ, 3.0, 3.0, "wall");
+    const double h = 0.15, a = fold / 2.0;
+    const Eigen::Vector3d left_axis(std::sin(a), std::cos(a), 0), right_axis(-std::sin(a), std::cos(a), 0);
+    scene.addRectangle(Eigen::Vector3d(2.0, 0, 1.0) + h * left_axis, left_axis, kZ, h, h, "left");
+    scene.addRectangle(Eigen::Vector3d(2.0, 0, 1.0) - h * right_axis, right_axis, kZ, h, h, "right");
+    const SceneRenderer renderer(scene);
+    PlaneDetector detector{DetectorParams()};
+    feed(detector, renderer.render(lookAt({0, 0, 1.0}, {3.0, 0, 1.0}), kinect(1.0), 1), 0.0);
+    const FramePlane* panel = nullptr;
+    for (const FramePlane& plane : detector.lastFramePlanes())
+      if (std::abs(std::abs(plane.d) - 2.0) < 0.02 && !plane.blocks.empty()) panel = &plane;
+    ASSERT_NE(panel, nullptr) << "fold " << fold;
+    EXPECT_GT(panel->blocks.size(), 100u) << "one region over both halves";
+    EXPECT_EQ(panel->fits_its_blocks, fold == 0.0) << "fold " << fold;
+  }
+}
+
+// A new panel 30 cm wide turned 0.08 rad off a known wall and 5 cm before it lies within three
+// merge tolerances of it: that may be the wall measured badly, so it is not reported at first
+// sight, while the same panel turned 0.3 rad is reported the first time a frame measures it.
+TEST(PlaneDetector, APlaneNearAKnownOneIsNotReportedAtFirstSight)
+{
+  for (double turn : {0.08, 0.3})
+  {
+    Scene wall_only;
+    wall_only.addRectangle({2.15, 0, 1.0}, kY, kZ, 3.0, 3.0, "wall");
+    Scene with_panel = wall_only;
+    const Eigen::Vector3d axis(std::sin(turn), std::cos(turn), 0), centre(2.1, 0, 1.0);
+    with_panel.addRectangle(centre, axis, kZ, 0.15, 0.15, "panel");
+    const Eigen::Vector3d panel_normal = axis.cross(kZ).normalized();
+    const double panel_d = -panel_normal.dot(centre);
+    const Eigen::Isometry3d pose = lookAt({0, 0, 1.0}, {3.0, 0, 1.0});
+    PlaneDetector detector{DetectorParams()};
+    feed(detector, SceneRenderer(wall_only).render(pose, kinect(1.0), 1), 0.0);
+    ASSERT_EQ(matching(detector.planes(), kX, -2.15, 0.01, 0.02).size(), 1u) << describe(detector.planes());
+    const SceneRenderer renderer(with_panel);
+    int frame = 2;
+    auto measured = [&] {
+      for (const FramePlane& plane : detector.lastFramePlanes())
+        if (unsignedAngle(plane.normal, panel_normal) < 0.05 && std::abs(std::abs(plane.d) - std::abs(panel_d)) < 0.03)
+          return true;
+      return false;
+    };
+    do feed(detector, renderer.render(pose, kinect(1.0), frame), 0.1 * frame);
+    while (!measured() && ++frame < 6);
+    ASSERT_TRUE(measured()) << "turn " << turn;
+    EXPECT_EQ(matching(detector.planes(), panel_normal, panel_d, 0.05, 0.03).size(), turn > 0.1 ? 1u : 0u)
+        << "turn " << turn << " at its first sight" << describe(detector.planes());
   }
 }
 

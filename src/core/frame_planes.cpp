@@ -246,8 +246,28 @@ FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d
   plane.parallel = parallel;
   plane.first_sight_points = tests_.firstSightPoints(blocks);
   plane.blocks = blocks;
+  plane.normal_sigma = tests_.normalUncertainty(blocks);
+  plane.fits_its_blocks = fitsItsBlocks(plane.normal, plane.d, plane.normal_sigma, blocks);
   describeMeasurement(plane, blocks);
   return plane;
+}
+
+bool FramePlaneFitter::fitsItsBlocks(const Eigen::Vector3d& normal, double d, double normal_sigma,
+                                     const std::vector<int>& blocks) const
+{
+  // Two tests against the sensor's noise: the blocks' centroids lie on the plane no farther
+  // than their variance says (mean chi^2 at most its expectation, 1), and the plane of the
+  // interior alone (no rim block that may lean over a fold) is within three sigmas of the
+  // normal's uncertainty. A region that took blocks of a neighbouring face or bends along a
+  // curved surface fails one of them.
+  const Eigen::Vector3d n_cam = frame_.normalInCamera(normal);
+  if (tests_.centroidChi2(n_cam, frame_.dInCamera(normal, d), blocks) > 1.0) return false;
+  const std::vector<int> interior = interiorBlocks(blocks, frame_.blocksX(), frame_.blocksY());
+  if (interior.size() < kMinInteriorBlocks) return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(tests_.weightedMoments(interior).covariance());
+  if (!(solver.eigenvalues()(1) > 1e-3 * solver.eigenvalues()(2))) return false;  // a row: no plane
+  return unsignedAngle(solver.eigenvectors().col(0), n_cam) <= 3.0 * normal_sigma;
 }
 
 void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const

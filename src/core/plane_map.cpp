@@ -50,6 +50,7 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   const float cap = static_cast<float>(params_.permanence_cap);
   // Thinning first, so a plane seen in this frame ends the frame at least 1 higher.
   thin(cap, frame_planes);
+  dropSuperseded(frame_planes);
   // Algorithm 2: every frame plane adds one Gaussian; the peaks are seeded from the cells of
   // this frame's planes and of the map's.
   // A plane this frame measured strongly enough to be reported at first sight (weight 2) is
@@ -158,8 +159,58 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
     }
   }
   if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
+  // A region whose blocks pass the noise tests of a plane (FramePlane::fits_its_blocks) is a
+  // complete measurement of a new surface whatever its size: one frame reports it, when it is
+  // precise enough that the next frame's measurement merges with it. Near a known plane it may
+  // be that plane measured badly, and waits for a second frame.
+  if (plane.fits_its_blocks && mergesWithItsRemeasurement(plane) && !nearKnownPlane(plane)) return 2.0f;
   const double bar = plane.parallel ? 0.25 * strong_support : strong_support;
   return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
+}
+
+bool PlaneMap::mergesWithItsRemeasurement(const FramePlane& measured) const
+{
+  // Two measurements of one surface differ by sqrt(2) sigma; both tolerances hold at 2 sigma
+  // of that difference. The offset is compared where the map compares it, at the world
+  // origin, so a tilt error grows with the lever arm from the origin to the measured points.
+  constexpr double kSigmas = 2.0 * M_SQRT2;
+  const Eigen::Vector3d lever = measured.centroid - measured.normal.dot(measured.centroid) * measured.normal;
+  const double d_sigma = std::hypot(measured.offset_sigma, measured.normal_sigma * lever.norm());
+  return kSigmas * measured.normal_sigma <= params_.merge_angle && kSigmas * d_sigma <= params_.merge_distance;
+}
+
+void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
+{
+  // A plane one frame's votes made (peak at most 2) that this frame does not measure again,
+  // while it measures a plane of at least its support within three merge tolerances of it, was
+  // that surface measured badly: the better measurement replaces it rather than stand beside it.
+  constexpr double kNearTolerances = 3.0;
+  for (const DetectedPlane& plane : planes_)
+  {
+    if (plane.strength > 2.0 || remeasured(plane, frame_planes)) continue;
+    for (const FramePlane& measured : frame_planes)
+    {
+      if (measured.support < plane.support ||
+          !withinMergeTolerances(plane.normal, plane.d, measured.normal, measured.d,
+                                 kNearTolerances * params_.merge_angle, kNearTolerances * params_.merge_distance))
+        continue;
+      forPeakCells(plane.hough, [&](int x, int y, int z) {
+        const float v = global_.value(x, y, z);
+        if (v > 0.0f) global_.add(x, y, z, -v);
+      });
+      break;
+    }
+  }
+}
+
+bool PlaneMap::nearKnownPlane(const FramePlane& measured) const
+{
+  constexpr double kNearTolerances = 3.0;  // beyond the merge, where a noisy re-measurement still falls
+  for (const DetectedPlane& known : planes_)
+    if (withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, kNearTolerances * params_.merge_angle,
+                              kNearTolerances * params_.merge_distance))
+      return true;
+  return false;
 }
 
 bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured) const
@@ -287,37 +338,39 @@ float PlaneMap::extentFade() const
   return params_.forgetting == kForgetByEvidence ? 0.0f : static_cast<float>(params_.thinning_rate);
 }
 
+void PlaneMap::forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const
+{
+  const int r = voting_.blurRadius() + params_.peak_window / 2 + 1;
+  std::vector<Eigen::Vector3d> centres{hough};
+  Eigen::Vector3d mirrored;
+  if (param_.mirror(hough, mirrored)) centres.push_back(mirrored);
+  for (const Eigen::Vector3d& centre : centres)
+  {
+    const Eigen::Vector3d c = param_.toCell(centre);
+    const int cx = static_cast<int>(std::lround(c.x())), cy = static_cast<int>(std::lround(c.y())),
+              cz = static_cast<int>(std::lround(c.z()));
+    for (int x = cx - r; x <= cx + r; ++x)
+      for (int y = cy - r; y <= cy + r; ++y)
+        for (int z = cz - r; z <= cz + r; ++z) f(x, y, z);
+  }
+}
+
 void PlaneMap::thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes)
 {
   // The cells around each established map plane's peak (its blur and peak window, and the
   // mirrored copy near the border) are kept as they are, a gone plane's are cleared; a plane
   // not yet established thins like everything else, a tentative one faster.
-  const int r = voting_.blurRadius() + params_.peak_window / 2 + 1;
   std::vector<std::pair<Eigen::Vector3i, float>> kept;
-  auto forBox = [&](const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) {
-    std::vector<Eigen::Vector3d> centres{hough};
-    Eigen::Vector3d mirrored;
-    if (param_.mirror(hough, mirrored)) centres.push_back(mirrored);
-    for (const Eigen::Vector3d& centre : centres)
-    {
-      const Eigen::Vector3d c = param_.toCell(centre);
-      const int cx = static_cast<int>(std::lround(c.x())), cy = static_cast<int>(std::lround(c.y())),
-                cz = static_cast<int>(std::lround(c.z()));
-      for (int x = cx - r; x <= cx + r; ++x)
-        for (int y = cy - r; y <= cy + r; ++y)
-          for (int z = cz - r; z <= cz + r; ++z) f(x, y, z);
-    }
-  };
   for (const DetectedPlane& plane : planes_)
   {
     const auto belief = beliefs_.find(plane.id);
     if (belief != beliefs_.end() && belief->second.gone())
-      forBox(plane.hough, [&](int x, int y, int z) {
+      forPeakCells(plane.hough, [&](int x, int y, int z) {
         const float v = global_.value(x, y, z);
         if (v > 0.0f) global_.add(x, y, z, -v);
       });
     else if (belief != beliefs_.end() && belief->second.established())
-      forBox(plane.hough, [&](int x, int y, int z) {
+      forPeakCells(plane.hough, [&](int x, int y, int z) {
         const float v = global_.value(x, y, z);
         if (v > 0.0f) kept.emplace_back(Eigen::Vector3i(x, y, z), v);
       });
@@ -330,7 +383,7 @@ void PlaneMap::thinByEvidence(float cap, const std::vector<FramePlane>& frame_pl
   {
     const auto belief = beliefs_.find(plane.id);
     if (belief == beliefs_.end() || !belief->second.tentative() || remeasured(plane, frame_planes)) continue;
-    forBox(plane.hough, [&](int x, int y, int z) {
+    forPeakCells(plane.hough, [&](int x, int y, int z) {
       const float v = global_.value(x, y, z);
       if (v > 0.0f) global_.add(x, y, z, -std::min(v, tentative_fade));
     });

@@ -55,6 +55,11 @@ struct FramePlane
   // offset there; 0 when unknown (the parallel search's planes).
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   double offset_sigma = 0.0;
+  // The standard error of its normal (rad) from its blocks; 0 when unknown.
+  double normal_sigma = 0.0;
+  // Its blocks lie on it within their noise and its interior's own plane agrees with it: a
+  // region leaning over a fold or a curve fails (the first-sight report, plane_map.cpp).
+  bool fits_its_blocks = false;
   std::vector<int> blocks;  // region_growing: the blocks of its region
 };
 
@@ -96,6 +101,7 @@ private:
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
   // Sets the plane's centroid and offset error from the blocks that measured it.
   void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
+  bool fitsItsBlocks(const Eigen::Vector3d& normal, double d, double normal_sigma, const std::vector<int>& blocks) const;
   // A region's accepted plane (world frame) as the map receives it.
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
                          const std::vector<int>& blocks) const;

@@ -4,6 +4,7 @@
 // serialise exactly this.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -72,6 +73,16 @@ private:
   void thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes);
   // True when the frame's plane lies on the map's within the merge tolerances (either side).
   bool samePlane(const DetectedPlane& known, const FramePlane& measured) const;
+  // True when a map plane lies within three merge tolerances of the frame's plane: more likely
+  // a noisy re-measurement of it than a new surface, so it is not reported at first sight.
+  bool nearKnownPlane(const FramePlane& measured) const;
+  // True when the frame's plane is precise enough that a second measurement of it falls within
+  // the merge tolerances of it.
+  bool mergesWithItsRemeasurement(const FramePlane& measured) const;
+  // Clears the cells of one-frame planes this frame measured again elsewhere, nearby.
+  void dropSuperseded(const std::vector<FramePlane>& frame_planes);
+  // Calls f on every cell of the peak window and blur around `hough` (and its mirrored copy).
+  void forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const;
   // True when one of this frame's planes lies on `plane` within the merge tolerances.
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
