@@ -281,6 +281,56 @@ TEST(PlaneMap, ATentativePlaneFadesOnlyInFramesThatDoNotMeasureItAgain)
   EXPECT_NEAR(matching(m.map.planes(), kFloor)[0]->strength, remeasured - PlaneBelief::kTentativeFade, 0.1);
 }
 
+// A region that fits its blocks is reported from one frame only when it is precise enough that
+// its next measurement merges with it: its normal, and its offset at the world origin, where the
+// map compares offsets (a tilt error grows with the lever arm), within the merge tolerances at 2
+// sigma of the difference of two measurements.
+TEST(PlaneMap, AFittingRegionIsReportedAtFirstSightOnlyWhenPreciseEnoughToMerge)
+{
+  struct Case
+  {
+    double normal_sigma;
+    Eigen::Vector3d centroid;
+    bool reported;
+  };
+  // merge_angle 0.05, merge_distance 0.03: at 2 sqrt(2) sigma, sigma_n <= 0.0177 and the offset's
+  // sigma at the origin <= 0.0106 m. A wall x = 2 (normal x): the lever is the centroid's (y, z).
+  for (const Case& c : {Case{0.002, {2.0, 0.0, 1.0}, true}, Case{0.02, {2.0, 0.0, 1.0}, false},
+                        Case{0.002, {2.0, 6.0, 1.0}, false}})
+  {
+    Map m;
+    FramePlane wall = m.plane(Eigen::Vector3d(1, 0, 0), -2.0, 3000);  // 3,000 points: 1.19 by its points
+    wall.fits_its_blocks = true;
+    wall.normal_sigma = c.normal_sigma;
+    wall.offset_sigma = 0.001;
+    wall.centroid = c.centroid;
+    m.frame({wall}, 0.0);
+    EXPECT_EQ(m.map.planes().size(), c.reported ? 1u : 0u) << "normal sigma " << c.normal_sigma << ", lever "
+                                                          << c.centroid.tail<2>().norm() << " m";
+  }
+}
+
+// A plane one frame reported that the next frame does not measure again, while that frame
+// measures a plane of at least its support within three merge tolerances of it, was that
+// surface measured badly: the better measurement replaces it. A weaker nearby plane does not.
+TEST(PlaneMap, AOneFramePlaneMeasuredAgainNearbyByABetterMeasurementIsReplaced)
+{
+  const Eigen::Vector3d tilted = Eigen::AngleAxisd(0.08, Eigen::Vector3d::UnitX()) * kFloor;  // 1.6 merge_angle
+  for (double later_support : {20000.0, 4000.0})
+  {
+    Map m;
+    m.params.forgetting = kForgetByThinning;  // a plane not measured again keeps 2 - thinning_rate
+    m.frame({m.plane(kFloor, 1.0, 16000)}, 0.0);
+    ASSERT_EQ(m.map.planes().size(), 1u);
+    FrameData frame;
+    m.map.observe({16000}, {}, frame, 0.0);
+    m.frame({m.plane(tilted, 1.0, later_support)}, 1.0);
+    const bool better = later_support >= 16000;
+    EXPECT_EQ(matching(m.map.planes(), kFloor).size(), better ? 0u : 1u) << "later support " << later_support;
+    EXPECT_EQ(matching(m.map.planes(), tilted).size(), better ? 1u : 0u) << "later support " << later_support;
+  }
+}
+
 TEST(PlaneMap, SerialisesToItselfExactly)
 {
   Map m;
