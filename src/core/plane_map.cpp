@@ -9,6 +9,11 @@
 
 namespace hough_plane_detector
 {
+namespace
+{
+// Beyond the merge tolerances, where a noisy re-measurement of a plane still falls.
+constexpr double kNearTolerances = 3.0;
+}  // namespace
 
 PlaneMap::PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
                    const HoughPeakSearch& peak_search)
@@ -181,10 +186,10 @@ bool PlaneMap::mergesWithItsRemeasurement(const FramePlane& measured) const
 
 void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
 {
-  // A plane one frame's votes made (peak at most 2) that this frame does not measure again,
-  // while it measures a plane of at least its support within three merge tolerances of it, was
-  // that surface measured badly: the better measurement replaces it rather than stand beside it.
-  constexpr double kNearTolerances = 3.0;
+  // A young plane (peak at most 2: one first-sight vote or two plain ones) that this frame does
+  // not measure again, while it measures a plane of at least its support within three merge
+  // tolerances of it, was that surface measured badly: the better measurement replaces it
+  // rather than stand beside it.
   for (const DetectedPlane& plane : planes_)
   {
     if (plane.strength > 2.0 || remeasured(plane, frame_planes)) continue;
@@ -194,10 +199,7 @@ void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
           !withinMergeTolerances(plane.normal, plane.d, measured.normal, measured.d,
                                  kNearTolerances * params_.merge_angle, kNearTolerances * params_.merge_distance))
         continue;
-      forPeakCells(plane.hough, [&](int x, int y, int z) {
-        const float v = global_.value(x, y, z);
-        if (v > 0.0f) global_.add(x, y, z, -v);
-      });
+      clearPeakCells(plane.hough);
       break;
     }
   }
@@ -205,7 +207,6 @@ void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
 
 bool PlaneMap::nearKnownPlane(const FramePlane& measured) const
 {
-  constexpr double kNearTolerances = 3.0;  // beyond the merge, where a noisy re-measurement still falls
   for (const DetectedPlane& known : planes_)
     if (withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, kNearTolerances * params_.merge_angle,
                               kNearTolerances * params_.merge_distance))
@@ -338,6 +339,14 @@ float PlaneMap::extentFade() const
   return params_.forgetting == kForgetByEvidence ? 0.0f : static_cast<float>(params_.thinning_rate);
 }
 
+void PlaneMap::clearPeakCells(const Eigen::Vector3d& hough)
+{
+  forPeakCells(hough, [&](int x, int y, int z) {
+    const float v = global_.value(x, y, z);
+    if (v > 0.0f) global_.add(x, y, z, -v);
+  });
+}
+
 void PlaneMap::forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const
 {
   const int r = voting_.blurRadius() + params_.peak_window / 2 + 1;
@@ -365,10 +374,7 @@ void PlaneMap::thinByEvidence(float cap, const std::vector<FramePlane>& frame_pl
   {
     const auto belief = beliefs_.find(plane.id);
     if (belief != beliefs_.end() && belief->second.gone())
-      forPeakCells(plane.hough, [&](int x, int y, int z) {
-        const float v = global_.value(x, y, z);
-        if (v > 0.0f) global_.add(x, y, z, -v);
-      });
+      clearPeakCells(plane.hough);
     else if (belief != beliefs_.end() && belief->second.established())
       forPeakCells(plane.hough, [&](int x, int y, int z) {
         const float v = global_.value(x, y, z);

@@ -81,6 +81,8 @@ private:
   bool mergesWithItsRemeasurement(const FramePlane& measured) const;
   // Clears the cells of one-frame planes this frame measured again elsewhere, nearby.
   void dropSuperseded(const std::vector<FramePlane>& frame_planes);
+  // Zeroes the cells forPeakCells visits.
+  void clearPeakCells(const Eigen::Vector3d& hough);
   // Calls f on every cell of the peak window and blur around `hough` (and its mirrored copy).
   void forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const;
   // True when one of this frame's planes lies on `plane` within the merge tolerances.
