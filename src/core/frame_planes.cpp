@@ -97,7 +97,7 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
       verdict = CandidateVerdict::kHalvesDisagree;
     const bool snapped =
         verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, blocks, map_planes, planes);
-    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(blocks))
+    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(tests_.normalUncertainty(blocks)))
       verdict = CandidateVerdict::kNormalUndetermined;
     candidates.push_back({normal, d, peak.value, moments.count, verdict});
     if (verdict != CandidateVerdict::kAccepted) continue;
@@ -193,7 +193,9 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     double d = frame_.dInWorld(normal, region.d);
     const bool snapped =
         verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, map_planes, planes);
-    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(region.blocks))
+    // Computed once: the orientation test and the accepted plane's record both need it.
+    const double normal_sigma = verdict == CandidateVerdict::kAccepted ? tests_.normalUncertainty(region.blocks) : 0.0;
+    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(normal_sigma))
       verdict = CandidateVerdict::kNormalUndetermined;
     candidates.push_back({normal, d, peak_value, std::max(region.points, moments.count), verdict});
     // A region on one surface that its points cannot orient keeps its blocks from the next
@@ -202,7 +204,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
       for (int b : region.blocks) frame_.block_claim[b] = 1;
     if (verdict != CandidateVerdict::kAccepted) return;
     for (int b : region.blocks) frame_.block_claim[b] = 1;
-    planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks));
+    planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks, normal_sigma));
   };
   constexpr size_t kMinSeedBlocks = 2;
   for (const HoughPeak& peak : peaks)
@@ -235,7 +237,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
 }
 
 FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d, double value, double support,
-                                         bool parallel, const std::vector<int>& blocks) const
+                                         bool parallel, const std::vector<int>& blocks, double normal_sigma) const
 {
   FramePlane plane;
   plane.normal = normal;
@@ -246,7 +248,7 @@ FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d
   plane.parallel = parallel;
   plane.first_sight_points = tests_.firstSightPoints(blocks);
   plane.blocks = blocks;
-  plane.normal_sigma = tests_.normalUncertainty(blocks);
+  plane.normal_sigma = normal_sigma;
   plane.fits_its_blocks = fitsItsBlocks(plane.normal, plane.d, plane.normal_sigma, blocks);
   describeMeasurement(plane, blocks);
   return plane;
@@ -324,13 +326,15 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
       region.normal = frame_.normalInCamera(kept.normal);
       region.d = frame_.dInCamera(kept.normal, kept.d);
       PointMoments moments;
-      if (testRegion(grower, region, moments) != CandidateVerdict::kAccepted || !normalDetermined(region.blocks) ||
+      if (testRegion(grower, region, moments) != CandidateVerdict::kAccepted) continue;
+      const double normal_sigma = tests_.normalUncertainty(region.blocks);
+      if (!normalDetermined(normal_sigma) ||
           tests_.centroidChi2(region.normal, region.d, kept.blocks) > kMaxMeanCentroidChi2 ||
           tests_.centroidChi2(region.normal, region.d, other.blocks) > kMaxMeanCentroidChi2)
         continue;
       const Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
       kept = regionPlane(normal, frame_.dInWorld(normal, region.d), std::max(kept.value, other.value), moments.count,
-                         false, region.blocks);
+                         false, region.blocks, normal_sigma);
       planes.erase(planes.begin() + pair.second);
       merged = true;
       break;  // indices moved: list the touching pairs again
@@ -358,11 +362,11 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
   return CandidateVerdict::kAccepted;
 }
 
-bool FramePlaneFitter::normalDetermined(const std::vector<int>& blocks) const
+bool FramePlaneFitter::normalDetermined(double normal_sigma) const
 {
   // Within merge_angle at two sigmas, so that every frame's fit of the surface lands on one
   // Hough peak; a plane the points cannot orient (a strip along a shelf's edge) is no plane.
-  return tests_.normalUncertainty(blocks) <= params_.merge_angle / 2.0;
+  return normal_sigma <= params_.merge_angle / 2.0;
 }
 
 const Eigen::Vector3d* FramePlaneFitter::closestKnownNormal(const Eigen::Vector3d& normal,
@@ -431,7 +435,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   if (!explained.interior) return false;
   // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
   // explains the face, its own normal is the better model, when the points determine it.
-  if (!explained.with_oriented_rim && normalDetermined(inliers)) return false;
+  if (!explained.with_oriented_rim && normalDetermined(tests_.normalUncertainty(inliers))) return false;
   normal = known;
   d = frame_.dInWorld(known, d_cam);
   return true;

@@ -102,13 +102,15 @@ private:
   // Sets the plane's centroid and offset error from the blocks that measured it.
   void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
   bool fitsItsBlocks(const Eigen::Vector3d& normal, double d, double normal_sigma, const std::vector<int>& blocks) const;
-  // A region's accepted plane (world frame) as the map receives it.
+  // A region's accepted plane (world frame) as the map receives it; normal_sigma is
+  // PlanarityTests::normalUncertainty of its blocks, which the caller has already computed.
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
-                         const std::vector<int>& blocks) const;
+                         const std::vector<int>& blocks, double normal_sigma) const;
   // Joins touching regions of this frame that the region tests accept as one plane.
   void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const;
-  // True when the blocks fix the normal within merge_angle / 3 (one sigma).
-  bool normalDetermined(const std::vector<int>& blocks) const;
+  // True when the normal's standard error (normalUncertainty of the blocks) is at most
+  // merge_angle / 2: within merge_angle at two sigmas.
+  bool normalDetermined(double normal_sigma) const;
   // The normal of the map's or this frame's planes closest to `normal` within snap_angle, or nullptr.
   const Eigen::Vector3d* closestKnownNormal(const Eigen::Vector3d& normal, const std::vector<DetectedPlane>& map_planes,
                                             const std::vector<FramePlane>& planes) const;
