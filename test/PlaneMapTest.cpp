@@ -122,6 +122,33 @@ TEST(PlaneMap, ASmallPatchParallelToAKnownPlaneIsReportedAtFirstSightOnlyWithThe
   EXPECT_EQ(larger.map.planes().size(), 1u);
 }
 
+// The quarter bar is for a plane that measured only its offset on one surface. A grown region
+// snapped to a known normal whose blocks do not fit it mixes surfaces: it needs the full bar.
+TEST(PlaneMap, AParallelRegionThatDoesNotFitItsBlocksNeedsTheFullFirstSightBar)
+{
+  struct Case
+  {
+    bool grown, fits;
+    double weighted_share;  // of strong_support
+    bool reported;
+  };
+  for (const Case& c : {Case{false, false, 0.3, true}, Case{true, true, 0.3, true}, Case{true, false, 0.3, false},
+                        Case{true, false, 1.0, true}})
+  {
+    Map m;
+    FramePlane shelf = m.plane(kFloor, 1.0, 3 * m.params.min_support, c.weighted_share * m.params.strong_support);
+    shelf.parallel = true;
+    if (c.grown) shelf.blocks = {1, 2, 3};
+    shelf.fits_its_blocks = c.fits;
+    // Too imprecise for the first sight of a fitting region: only the bar decides.
+    shelf.normal_sigma = 0.05;
+    m.frame({shelf}, 0.0);
+    EXPECT_EQ(m.map.planes().size(), c.reported ? 1u : 0u)
+        << (c.grown ? "grown region" : "parallel search") << ", fits " << c.fits << ", weighted points "
+        << c.weighted_share << " strong_support";
+  }
+}
+
 TEST(PlaneMap, TwoPatchesOfOneSurfaceInOneFrameArePooledForTheFirstSightBar)
 {
   // A box top at 0.55 m grown as two regions (0.5 cm and 0.03 rad apart, within the merge

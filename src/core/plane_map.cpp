@@ -143,7 +143,9 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // (thinning and permanence keep their pace). Noisier sensors need more points for the same
   // precision: the bar rises with sensor_noise^2, and near points count more (detector_params.h).
   // A plane of the parallel search, or one snapped to a known normal, measured only its
-  // offset, so a quarter of the points is as strong. One of under 2 min_support points is too
+  // offset, so a quarter of the points is as strong; not so a grown region that does not fit
+  // its blocks (FramePlane::fits_its_blocks): it mixes surfaces (a shelf board's top with its
+  // front), and its offset is none of theirs. One of under 2 min_support points is too
   // small for the curvature tests: it waits for a second frame, unless it is parallel and its
   // weighted points reach the full bar (a box top near the sensor).
   for (const DetectedPlane& known : planes_)
@@ -169,7 +171,8 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // precise enough that the next frame's measurement merges with it. Near a known plane it may
   // be that plane measured badly, and waits for a second frame.
   if (plane.fits_its_blocks && mergesWithItsRemeasurement(plane) && !nearKnownPlane(plane)) return 2.0f;
-  const double bar = plane.parallel ? 0.25 * strong_support : strong_support;
+  const bool offset_only = plane.parallel && (plane.blocks.empty() || plane.fits_its_blocks);
+  const double bar = offset_only ? 0.25 * strong_support : strong_support;
   return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
 }
 
