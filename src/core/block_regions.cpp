@@ -264,11 +264,8 @@ bool BlockRegionGrower::fit(const std::vector<int>& blocks, Eigen::Vector3d& nor
 {
   if (blocks.size() < 3) return false;
   const PointMoments sum = weightedCentroidMoments(info_, blocks);
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(sum.covariance());
-  // Centroids along one line (a row of blocks) fix no plane.
-  if (!(solver.eigenvalues()(1) > 1e-3 * solver.eigenvalues()(2))) return false;
-  Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
+  Eigen::Vector3d n;
+  if (!sum.planeNormal(n)) return false;
   if (n.dot(normal) < 0.0) n = -n;
   normal = n;
   d = -n.dot(sum.mean());

@@ -266,10 +266,9 @@ bool FramePlaneFitter::fitsItsBlocks(const Eigen::Vector3d& normal, double d, do
   if (tests_.centroidChi2(n_cam, frame_.dInCamera(normal, d), blocks) > 1.0) return false;
   const std::vector<int> interior = interiorBlocks(blocks, frame_.blocksX(), frame_.blocksY());
   if (interior.size() < kMinInteriorBlocks) return false;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(tests_.weightedMoments(interior).covariance());
-  if (!(solver.eigenvalues()(1) > 1e-3 * solver.eigenvalues()(2))) return false;  // a row: no plane
-  return unsignedAngle(solver.eigenvectors().col(0), n_cam) <= 3.0 * normal_sigma;
+  Eigen::Vector3d interior_normal;
+  if (!tests_.weightedMoments(interior).planeNormal(interior_normal)) return false;
+  return unsignedAngle(interior_normal, n_cam) <= 3.0 * normal_sigma;
 }
 
 void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const

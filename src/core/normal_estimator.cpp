@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <Eigen/Eigenvalues>
+
 #ifdef __SSE2__
 #include <xmmintrin.h>
 #endif
@@ -31,6 +33,15 @@ Eigen::Matrix3d PointMoments::covariance() const
   c(2, 0) = c(0, 2);
   c(2, 1) = c(1, 2);
   return c;
+}
+
+bool PointMoments::planeNormal(Eigen::Vector3d& normal) const
+{
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance());
+  if (!(solver.eigenvalues()(1) > 1e-3 * solver.eigenvalues()(2))) return false;
+  normal = solver.eigenvectors().col(0).normalized();
+  return true;
 }
 
 PointMoments PointMoments::transformed(const Eigen::Isometry3d& transform) const

@@ -101,6 +101,8 @@ private:
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
   // Sets the plane's centroid and offset error from the blocks that measured it.
   void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
+  // FramePlane::fits_its_blocks: the blocks' centroids and the interior's own plane agree with
+  // (normal, d) within the sensor's noise.
   bool fitsItsBlocks(const Eigen::Vector3d& normal, double d, double normal_sigma, const std::vector<int>& blocks) const;
   // A region's accepted plane (world frame) as the map receives it; normal_sigma is
   // PlanarityTests::normalUncertainty of its blocks, which the caller has already computed.

@@ -37,6 +37,9 @@ struct PointMoments
   void scale(double w);
   Eigen::Vector3d mean() const { return sum / count; }
   Eigen::Matrix3d covariance() const;
+  // The normal of their least-squares plane (unit, either sign); false when they lie along a
+  // line (a row of blocks), which fixes no plane.
+  bool planeNormal(Eigen::Vector3d& normal) const;
   // The same points moved by a rigid transform.
   PointMoments transformed(const Eigen::Isometry3d& transform) const;
 };
