@@ -376,6 +376,16 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
   for (size_t v = 0; v < e.variants.size(); ++v)
     table += fmt("| %zu held-out ", e.held_out_seeds) + accuracyRow(e.variants[v], e.held_out[v]);
   table += fmt("| %zu held-out, at C = 1 ", e.held_out_seeds) + accuracyRow(e.variants.front(), e.held_out_at_c1);
+  // The verdict pools both held-out lists: the second one makes the false-plane rate firmer.
+  MethodStats pooled = e.held_out.front(), pooled_at_c1 = e.held_out_at_c1;
+  pooled.merge(e.second_held_out);
+  pooled_at_c1.merge(e.second_held_out_at_c1);
+  const size_t all_held_out = e.held_out_seeds + e.second_held_out_seeds;
+  table += fmt("| %zu second held-out ", e.second_held_out_seeds) + accuracyRow(e.variants.front(), e.second_held_out);
+  table += fmt("| %zu second held-out, at C = 1 ", e.second_held_out_seeds) +
+           accuracyRow(e.variants.front(), e.second_held_out_at_c1);
+  table += fmt("| **all %zu held-out** ", all_held_out) + accuracyRow(e.variants.front(), pooled);
+  table += fmt("| **all %zu held-out, at C = 1** ", all_held_out) + accuracyRow(e.variants.front(), pooled_at_c1);
   for (size_t v = 0; v < e.variants.size(); ++v)
     table += fmt("| %zu tuning ", e.tuning_seeds) + accuracyRow(e.variants[v], e.tuning[v]);
   std::string rows;
@@ -393,7 +403,10 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
                    "any threshold was chosen on these rooms and are reported only; tuning looks at seeds 901-908 "
                    "only. The rows without the parallel search and without the snap show what each of those rules "
                    "adds. The row at C = 1 renders the same held-out rooms and paths at C = 1, the condition the "
-                   "targets are stated at; the rows above it keep each room's own C. Targets on the held-out seeds: "
+                   "targets are stated at; the rows above it keep each room's own C. A second held-out list "
+                   "(seeds 121-160, the defaults only) was written down later, before any run on it, because 20 "
+                   "rooms left the false-plane rate uncertain by about half its value; the verdicts pool both "
+                   "lists. Targets on the held-out seeds: "
                    ">= 95 %% detected, <= 0.05 false planes per frame, E_angle <= 0.01 rad, E_d <= 1 cm.\n\n",
                    e.frames, kWarmupFrames)
             << table << "\n| held-out seed | room | defaults detected | false / frame | windows detected | "
@@ -405,8 +418,8 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
                        "frame <= 0.05, E_angle %.4f rad, E_d %.4f m",
                        which, h.detectionPercent(), h.falsePerFrame(), mean(h.angle), mean(h.d)));
   };
-  verdict(e.held_out.front(), "each room's C, 0.5-2");
-  verdict(e.held_out_at_c1, "C = 1");
+  verdict(pooled, fmt("all %zu seeds, each room's C, 0.5-2", all_held_out).c_str());
+  verdict(pooled_at_c1, fmt("all %zu seeds, C = 1", all_held_out).c_str());
 }
 
 // ../shared/data/kinect-real: a still camera, no ground truth; time and planes found.

@@ -1,6 +1,6 @@
 // The rendered sets a change to the detector may be judged and tuned on, in about a minute
 // (make tuning-check): the tuning and development seeds of the procedural rooms (the latter
-// also at C = 1, where make evaluate's held-out verdict is made), Table 3's
+// also at C = 1, where make evaluate's held-out verdict is made), the second development list at C = 1, Table 3's
 // tours, its scenes along the other paths and Fig. 7's office at C = 4, each as one line with the
 // same scoring as make evaluate (PCL's methods left out). The held-out seeds are not here on
 // purpose: their figures come from make evaluate only, after a change is decided.
@@ -117,13 +117,13 @@ void print(const SetResult& r, bool causes)
 int main(int argc, char** argv)
 {
   namespace po = boost::program_options;
-  std::string sets = "tuning,development,development-c1,table3,other,fig7", osd_dir;
+  std::string sets = "tuning,development,development-c1,development-b,table3,other,fig7", osd_dir;
   DetectorParams scratch;  // the flags' values are checked here, then applied to every detector
   po::options_description options("options"), detector_options("detector parameters (applied to every run)"), hidden;
   options.add_options()("help,h", "this help")
       ("sets", po::value(&sets)->value_name("LIST"),
        "comma-separated: tuning (seeds 901-908), development (950-965), development-c1 (the same at C = 1), "
-       "table3, other, fig7 (default: all)")
+       "development-b (300-339 at C = 1), table3, other, fig7 (default: all)")
       ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
       ("causes", "our misses of each set by what became of their candidate");
   addDetectorParamOptions(scratch, detector_options, hidden);
@@ -167,6 +167,8 @@ int main(int argc, char** argv)
       runs.push_back([&] { return runRooms("development seeds", kDevelopmentSeeds, params_for); });
     else if (set == "development-c1")
       runs.push_back([&] { return runRooms("development seeds, C = 1", kDevelopmentSeeds, params_for, 1.0); });
+    else if (set == "development-b")
+      runs.push_back([&] { return runRooms("development B seeds, C = 1", kSecondDevelopmentSeeds, params_for, 1.0); });
     else if (set == "table3")
       runs.push_back([&] { return runTableThree(params_for); });
     else if (set == "other")
@@ -175,7 +177,7 @@ int main(int argc, char** argv)
       runs.push_back([&] { return runFigureSeven(params_for); });
     else
     {
-      std::cerr << "tuning_check: unknown set '" << set << "' (tuning, development, development-c1, table3, other, fig7)\n";
+      std::cerr << "tuning_check: unknown set '" << set << "' (tuning, development, development-c1, development-b, table3, other, fig7)\n";
       return 2;
     }
   }
