@@ -249,26 +249,30 @@ FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d
   plane.first_sight_points = tests_.firstSightPoints(blocks);
   plane.blocks = blocks;
   plane.normal_sigma = normal_sigma;
-  plane.fits_its_blocks = fitsItsBlocks(plane.normal, plane.d, plane.normal_sigma, blocks);
+  testFitToBlocks(plane, blocks);
   describeMeasurement(plane, blocks);
   return plane;
 }
 
-bool FramePlaneFitter::fitsItsBlocks(const Eigen::Vector3d& normal, double d, double normal_sigma,
-                                     const std::vector<int>& blocks) const
+void FramePlaneFitter::testFitToBlocks(FramePlane& plane, const std::vector<int>& blocks) const
 {
-  // Two tests against the sensor's noise: the blocks' centroids lie on the plane no farther
-  // than their variance says (mean chi^2 at most its expectation, 1), and the plane of the
-  // interior alone (no rim block that may lean over a fold) is within three sigmas of the
-  // normal's uncertainty. A region that took blocks of a neighbouring face or bends along a
-  // curved surface fails one of them.
-  const Eigen::Vector3d n_cam = frame_.normalInCamera(normal);
-  if (tests_.centroidChi2(n_cam, frame_.dInCamera(normal, d), blocks) > 1.0) return false;
+  // Against the sensor's noise. It fits its blocks when their centroids lie on the plane no
+  // farther than their variance says (mean chi^2 at most its expectation, 1) and the interior's
+  // own plane (no rim block that may lean over a fold) is within three sigmas of the normal's
+  // uncertainty: a region that took blocks of a neighbouring face or bends along a curve fails
+  // one of them. It mixes surfaces when that chi^2 is beyond what noise reaches once in a
+  // hundred regions; real faces (osd-learn's boxes) often fail the interior test, not this one.
+  plane.fits_its_blocks = plane.mixes_surfaces = false;
+  if (blocks.empty()) return;
+  const Eigen::Vector3d n_cam = frame_.normalInCamera(plane.normal);
+  const double mean_chi2 = tests_.centroidChi2(n_cam, frame_.dInCamera(plane.normal, plane.d), blocks);
+  plane.mixes_surfaces = mean_chi2 > noiseBoundOfMeanChi2(blocks.size());
+  if (mean_chi2 > 1.0) return;
   const std::vector<int> interior = interiorBlocks(blocks, frame_.blocksX(), frame_.blocksY());
-  if (interior.size() < kMinInteriorBlocks) return false;
+  if (interior.size() < kMinInteriorBlocks) return;
   Eigen::Vector3d interior_normal;
-  if (!tests_.weightedMoments(interior).planeNormal(interior_normal)) return false;
-  return unsignedAngle(interior_normal, n_cam) <= 3.0 * normal_sigma;
+  if (!tests_.weightedMoments(interior).planeNormal(interior_normal)) return;
+  plane.fits_its_blocks = unsignedAngle(interior_normal, n_cam) <= 3.0 * plane.normal_sigma;
 }
 
 void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const

@@ -151,6 +151,9 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   for (const DetectedPlane& known : planes_)
     if (samePlane(known, plane)) return 1.0f;
   if (params_.strong_support <= 0) return 1.0f;
+  // A region whose blocks lie off its plane beyond their noise is no measurement of one
+  // surface, however large: it votes 1 as in the paper, and a second frame decides.
+  if (plane.mixes_surfaces) return 1.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
   // Whether a surface is too small for the curvature tests does not depend on how many regions
   // the frame grew on it (a box top split in two): that test pools the points and support of
@@ -168,23 +171,22 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
   // A region whose blocks pass the noise tests of a plane (FramePlane::fits_its_blocks) is a
   // complete measurement of a new surface whatever its size: one frame reports it, when it is
-  // precise enough that the next frame's measurement merges with it. Near a known plane it may
-  // be that plane measured badly, and waits for a second frame.
-  if (plane.fits_its_blocks && mergesWithItsRemeasurement(plane) && !nearKnownPlane(plane)) return 2.0f;
+  // precise enough that a second measurement would agree with it. Near a known plane it may be
+  // that plane measured badly, and waits for a second frame.
+  if (plane.fits_its_blocks && preciseAtFirstSight(plane) && !nearKnownPlane(plane)) return 2.0f;
   const bool offset_only = plane.parallel && (plane.blocks.empty() || plane.fits_its_blocks);
   const double bar = offset_only ? 0.25 * strong_support : strong_support;
   return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
 }
 
-bool PlaneMap::mergesWithItsRemeasurement(const FramePlane& measured) const
+bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 {
   // Two measurements of one surface differ by sqrt(2) sigma; both tolerances hold at 2 sigma
-  // of that difference. The offset is compared where the map compares it, at the world
-  // origin, so a tilt error grows with the lever arm from the origin to the measured points.
+  // of that difference. The offset is judged where the surface was measured, at its points: a
+  // far face's small tilt error moves its offset at the world origin, not the surface shown.
   constexpr double kSigmas = 2.0 * M_SQRT2;
-  const Eigen::Vector3d lever = measured.centroid - measured.normal.dot(measured.centroid) * measured.normal;
-  const double d_sigma = std::hypot(measured.offset_sigma, measured.normal_sigma * lever.norm());
-  return kSigmas * measured.normal_sigma <= params_.merge_angle && kSigmas * d_sigma <= params_.merge_distance;
+  return kSigmas * measured.normal_sigma <= params_.merge_angle &&
+         kSigmas * measured.offset_sigma <= params_.merge_distance;
 }
 
 void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)

@@ -60,6 +60,9 @@ struct FramePlane
   // Its blocks lie on it within their noise and its interior's own plane agrees with it: a
   // region leaning over a fold or a curve fails (the first-sight report, plane_map.cpp).
   bool fits_its_blocks = false;
+  // Its blocks' centroids lie off it beyond their noise (p = 0.01, noiseBoundOfMeanChi2): it
+  // took blocks of another surface or bends, so one frame does not report it (plane_map.cpp).
+  bool mixes_surfaces = false;
   std::vector<int> blocks;  // region_growing: the blocks of its region
 };
 
@@ -101,9 +104,9 @@ private:
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
   // Sets the plane's centroid and offset error from the blocks that measured it.
   void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
-  // FramePlane::fits_its_blocks: the blocks' centroids and the interior's own plane agree with
-  // (normal, d) within the sensor's noise.
-  bool fitsItsBlocks(const Eigen::Vector3d& normal, double d, double normal_sigma, const std::vector<int>& blocks) const;
+  // FramePlane::fits_its_blocks and mixes_surfaces: how the blocks' centroids, and the interior's
+  // own plane, agree with (normal, d) within the sensor's noise.
+  void testFitToBlocks(FramePlane& plane, const std::vector<int>& blocks) const;
   // A region's accepted plane (world frame) as the map receives it; normal_sigma is
   // PlanarityTests::normalUncertainty of its blocks, which the caller has already computed.
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,

@@ -3,6 +3,8 @@
 // agree, does a given normal explain them as well as their own fit.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <vector>
 
@@ -17,6 +19,13 @@ namespace hough_plane_detector
 constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
 constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
 constexpr double kMaxSnapChi2Increase = 9.21;      // a known normal's fit: chi^2 with 2 dof, p = 0.01
+
+// The mean chi^2 per block that n block centroids exceed about their true plane with p = 0.01
+// (chi^2 with n dof over n, its normal approximation).
+inline double noiseBoundOfMeanChi2(size_t blocks)
+{
+  return 1.0 + 2.33 * std::sqrt(2.0 / static_cast<double>(std::max<size_t>(1, blocks)));
+}
 
 class PlanarityTests
 {

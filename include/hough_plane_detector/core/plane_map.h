@@ -77,8 +77,8 @@ private:
   // a noisy re-measurement of it than a new surface, so it is not reported at first sight.
   bool nearKnownPlane(const FramePlane& measured) const;
   // True when the frame's plane is precise enough that a second measurement of it falls within
-  // the merge tolerances of it.
-  bool mergesWithItsRemeasurement(const FramePlane& measured) const;
+  // the merge tolerances of it: its normal, and its offset at its own points.
+  bool preciseAtFirstSight(const FramePlane& measured) const;
   // Clears the cells of one-frame planes this frame measured again elsewhere, nearby.
   void dropSuperseded(const std::vector<FramePlane>& frame_planes);
   // Zeroes the cells forPeakCells visits.
