@@ -1,4 +1,4 @@
-// The rendered sets a change to the detector may be judged and tuned on, in about a minute
+// The rendered sets a change to the detector may be judged and tuned on, in about two and a half minutes
 // (make tuning-check): the tuning and development seeds of the procedural rooms (the latter
 // also at C = 1, where make evaluate's held-out verdict is made), the second development list at C = 1, Table 3's
 // tours, its scenes along the other paths and Fig. 7's office at C = 4, each as one line with the
