@@ -364,7 +364,7 @@ RandomSceneExperiment runRandomScenes(bool quick)
     runSeed(kHeldOutSeeds[i], at_c1, false, 1.0);
   }
   result.held_out_at_c1 = at_c1.front();
-  // The second list: the defaults only (variants[0]), a row each in the report's room table.
+  // The second list: the defaults only (variants[0]), pooled with the first in the verdicts.
   std::vector<MethodStats> second(1), second_at_c1(1);
   for (size_t i = 0; i < result.second_held_out_seeds; ++i)
   {
