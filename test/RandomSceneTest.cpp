@@ -28,11 +28,15 @@ TEST(RandomScene, ASeedAlwaysGivesTheSameRoomAndOthersDiffer)
   EXPECT_NE(a.description, other.description);
 }
 
+// Both held-out lists: no seed twice, and none on the tuning or development lists.
 TEST(RandomScene, HeldOutAndTuningSeedsAreDisjoint)
 {
-  const std::set<uint32_t> held_out(kHeldOutSeeds.begin(), kHeldOutSeeds.end());
+  std::set<uint32_t> held_out(kHeldOutSeeds.begin(), kHeldOutSeeds.end());
   EXPECT_GE(held_out.size(), 20u);
-  for (uint32_t seed : kTuningSeeds) EXPECT_EQ(held_out.count(seed), 0u) << seed;
+  for (uint32_t seed : kSecondHeldOutSeeds) EXPECT_TRUE(held_out.insert(seed).second) << "listed twice: " << seed;
+  EXPECT_GE(held_out.size(), 60u);
+  for (const auto* tuned : {&kTuningSeeds, &kDevelopmentSeeds, &kSecondDevelopmentSeeds})
+    for (uint32_t seed : *tuned) EXPECT_EQ(held_out.count(seed), 0u) << seed;
 }
 
 // Every room has its floor and walls, the camera inside looking at them within the stated
