@@ -36,10 +36,13 @@ TEST(BagPlayback, NodeletOnAPlayedBagMatchesTheOfflineTool)
   ASSERT_GE(expected.size(), 3u) << offline;
 
   PlaneArrayRecorder recorder;
-  ros::WallDuration(2.0).sleep();  // let the subscription connect
-  const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 1 " + bag, &code);
+  ASSERT_TRUE(waitUntil([&] { return recorder.connected() && hasSubscriber("/camera/depth/points"); }, 60.0))
+      << "the detector never subscribed to /camera/depth/points";
+  // -d: rosbag's new publisher is connected to by the detector before the first cloud.
+  const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 2 " + bag, &code);
   ASSERT_EQ(code, 0) << played;
-  ros::WallDuration(2.0).sleep();
+  const double last_stamp = 100.0 + 0.1 * (frames - 1);
+  waitUntil([&] { return recorder.receivedStamp(last_stamp); }, 60.0);
 
   const std::vector<PlaneArray::ConstPtr> received = recorder.received();
   std::string stamps;
@@ -47,7 +50,7 @@ TEST(BagPlayback, NodeletOnAPlayedBagMatchesTheOfflineTool)
   ASSERT_EQ(received.size(), static_cast<size_t>(frames)) << "every played cloud gives one plane array; got" << stamps;
   const PlaneArray& last = *received.back();
   EXPECT_EQ(last.header.frame_id, "odom");
-  EXPECT_NEAR(last.header.stamp.toSec(), 100.0 + 0.1 * (frames - 1), 1e-6);
+  EXPECT_NEAR(last.header.stamp.toSec(), last_stamp, 1e-6);
   ASSERT_EQ(last.planes.size(), expected.size()) << offline;
   for (size_t i = 0; i < expected.size(); ++i)
   {

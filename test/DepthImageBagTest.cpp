@@ -22,17 +22,27 @@ TEST(DepthImage, ATumStyleBagGivesTheRoomsPlanes)
   const std::vector<TruePlane> truth = writeTumBag(bag, kTumFrames);
 
   PlaneArrayRecorder recorder;
-  ros::WallDuration(3.0).sleep();  // let the subscriptions (ours, the detector's, depth_image_proc's) connect
+  // depth_image_proc asks for depth images only once its cloud has a subscriber (the detector):
+  // the chain is up when both inputs have a subscriber and the detector's planes reach us.
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        return recorder.connected() && hasSubscriber("/camera/depth/image") &&
+               hasSubscriber("/camera/depth/camera_info");
+      },
+      60.0))
+      << "the detector and depth_image_proc never subscribed";
   int code = 0;
-  const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 1 " + bag, &code);
+  // -d: rosbag's new publishers are connected to by the subscribers before the first message.
+  const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 2 " + bag, &code);
   ASSERT_EQ(code, 0) << played;
-  ros::WallDuration(2.0).sleep();
+  const double last_stamp = kTumStart + (kTumFrames - 1) / 30.0;
+  waitUntil([&] { return recorder.receivedStamp(last_stamp); }, 60.0);
 
   const std::vector<PlaneArray::ConstPtr> received = recorder.received();
   ASSERT_FALSE(received.empty()) << "no plane array: the depth images never became clouds the detector took";
   const PlaneArray& last = *received.back();
   EXPECT_EQ(last.header.frame_id, "world");
-  EXPECT_NEAR(last.header.stamp.toSec(), kTumStart + (kTumFrames - 1) / 30.0, 1e-6) << "the recording's stamps are kept";
+  EXPECT_NEAR(last.header.stamp.toSec(), last_stamp, 1e-6) << "the recording's stamps are kept";
   // Every large plane of the last frame (the floor, the walls in view), once, within 0.01 rad and 2 cm.
   ASSERT_GE(truth.size(), 2u);
   for (const TruePlane& t : truth)

@@ -28,6 +28,16 @@ public:
       received_.push_back(m);
     });
   }
+  // Whether the detector's publisher is connected to this subscription.
+  bool connected() const { return subscriber_.getNumPublishers() > 0; }
+  // Whether an array stamped `stamp` (within 1 us) has arrived.
+  bool receivedStamp(double stamp) const
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const PlaneArray::ConstPtr& m : received_)
+      if (std::abs(m->header.stamp.toSec() - stamp) < 1e-6) return true;
+    return false;
+  }
   std::vector<PlaneArray::ConstPtr> received() const
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <ros/master.h>
 #include <ros/ros.h>
 #include <Eigen/Geometry>
 #include <rosbag/bag.h>
@@ -199,6 +200,33 @@ inline int runRosTests(int argc, char** argv, const char* name)
   const int result = RUN_ALL_TESTS();
   spinner.stop();
   return result;
+}
+
+// Polls `done` every 50 ms until it holds or `seconds` (wall time) pass; whether it held. Tests
+// wait on what they need rather than for a fixed time, which a loaded machine can outlast.
+template <class Done>
+bool waitUntil(Done done, double seconds)
+{
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (!done())
+  {
+    if (ros::WallTime::now() > end) return false;
+    ros::WallDuration(0.05).sleep();
+  }
+  return true;
+}
+
+// Whether the master lists at least one subscriber of `topic` (a node that will connect to
+// whoever publishes it, as rosbag play's publishers).
+inline bool hasSubscriber(const std::string& topic)
+{
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  if (!ros::master::execute("getSystemState", request, response, payload, false)) return false;
+  XmlRpc::XmlRpcValue& subscribers = payload[1];
+  for (int i = 0; i < subscribers.size(); ++i)
+    if (static_cast<std::string>(subscribers[i][0]) == topic) return subscribers[i][1].size() > 0;
+  return false;
 }
 
 // Runs a shell command; its stdout and stderr, and its exit code (-1 when it did not exit).
