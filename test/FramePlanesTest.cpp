@@ -1,6 +1,7 @@
 // The per-frame fits from Hough peaks (windows and block regions) on a rendered frame.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "hough_plane_detector/core/frame_planes.h"
@@ -41,4 +42,48 @@ TEST(FramePlaneFitter, BothFitsRecoverTheFloorAndTheWallFromTheirPeaks)
     for (char c : f.frame.block_claim) claimed += c;
     EXPECT_GT(claimed, 200u);
   }
+}
+
+// A small far piece of the wall whose own fit came out nearer another known plane's normal
+// (0.03 rad off, 1 m behind the piece) than the wall's: its blocks cannot tell the two
+// directions apart, so the snap takes the wall's, the plane the piece lies on; with no
+// such plane known it takes the nearest normal, as before.
+TEST(FramePlaneFitter, ASnapPrefersTheKnownPlaneThePieceLiesOn)
+{
+  Frame f;
+  FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
+  const TruePlane& wall = f.renderer.truePlanes()[f.truePlane("wall")];
+  // A 3 x 3 block patch in the middle of the wall's blocks.
+  const std::vector<int> wall_blocks = f.blocksOn(f.truePlane("wall"));
+  ASSERT_FALSE(wall_blocks.empty());
+  const int row = f.wallRow(wall_blocks), bx_count = f.frame.blocksX();
+  int low = bx_count, high = 0;
+  for (int b : wall_blocks)
+    if (b / bx_count == row) low = std::min(low, b % bx_count), high = std::max(high, b % bx_count);
+  const int column = (low + high) / 2;
+  std::vector<int> piece;
+  for (int y = row - 1; y <= row + 1; ++y)
+    for (int x = column - 1; x <= column + 1; ++x) piece.push_back(y * bx_count + x);
+  for (int b : piece) ASSERT_TRUE(std::find(wall_blocks.begin(), wall_blocks.end(), b) != wall_blocks.end());
+
+  DetectedPlane known_wall;
+  known_wall.normal = wall.normal;
+  known_wall.d = wall.d;
+  DetectedPlane turned;  // another surface's plane, turned 0.03 rad about the vertical, 1 m behind
+  turned.normal = Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitZ()) * wall.normal;
+  const Eigen::Vector3d on_wall = -wall.d * wall.normal;
+  turned.d = -turned.normal.dot(on_wall + 1.0 * wall.normal);
+  const Eigen::Vector3d piece_fit = Eigen::AngleAxisd(0.035, Eigen::Vector3d::UnitZ()) * wall.normal;
+
+  Eigen::Vector3d normal = piece_fit;
+  double d = wall.d;
+  ASSERT_TRUE(fitter.snapToKnownDirection(normal, d, piece, {turned}, {}))
+      << "the piece's blocks must not tell 0.03 rad, or the test shows nothing";
+  EXPECT_LT(angleBetween(normal, turned.normal), 1e-9) << "alone, the nearest known normal is taken";
+
+  normal = piece_fit;
+  d = wall.d;
+  ASSERT_TRUE(fitter.snapToKnownDirection(normal, d, piece, {turned, known_wall}, {}));
+  EXPECT_LT(angleBetween(normal, wall.normal), 1e-9) << "the wall's normal, the plane the piece lies on";
+  EXPECT_NEAR(std::abs(d), std::abs(wall.d), 0.02);
 }

@@ -372,23 +372,33 @@ bool FramePlaneFitter::normalDetermined(double normal_sigma) const
   return normal_sigma <= params_.merge_angle / 2.0;
 }
 
-const Eigen::Vector3d* FramePlaneFitter::closestKnownNormal(const Eigen::Vector3d& normal,
-                                                           const std::vector<DetectedPlane>& map_planes,
-                                                           const std::vector<FramePlane>& planes) const
+const Eigen::Vector3d* FramePlaneFitter::knownNormalFor(const Eigen::Vector3d& normal, const Eigen::Vector3d& centroid,
+                                                       const std::vector<DetectedPlane>& map_planes,
+                                                       const std::vector<FramePlane>& planes) const
 {
+  // A piece of a known plane is most likely that surface re-measured: its direction comes
+  // before a parallel plane's elsewhere that happens to be closer to the piece's noisy fit
+  // (a far strip of a wall fitted 0.05 rad off, nearer a box face's normal than the wall's).
   const Eigen::Vector3d* closest = nullptr;
-  double closest_angle = params_.snap_angle;
-  auto consider = [&](const Eigen::Vector3d& known_normal) {
+  const Eigen::Vector3d* closest_on = nullptr;
+  double closest_angle = params_.snap_angle, closest_on_angle = params_.snap_angle;
+  auto consider = [&](const Eigen::Vector3d& known_normal, double known_d) {
     const double angle = unsignedAngle(known_normal, normal);
+    if (angle >= closest_angle && angle >= closest_on_angle) return;
     if (angle < closest_angle)
     {
       closest_angle = angle;
       closest = &known_normal;
     }
+    if (angle < closest_on_angle && std::abs(known_normal.dot(centroid) + known_d) <= params_.merge_distance)
+    {
+      closest_on_angle = angle;
+      closest_on = &known_normal;
+    }
   };
-  for (const DetectedPlane& plane : map_planes) consider(plane.normal);
-  for (const FramePlane& plane : planes) consider(plane.normal);
-  return closest;
+  for (const DetectedPlane& plane : map_planes) consider(plane.normal, plane.d);
+  for (const FramePlane& plane : planes) consider(plane.normal, plane.d);
+  return closest_on ? closest_on : closest;
 }
 
 bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
@@ -399,9 +409,13 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // top) is fitted with a tilt of a few degrees: blocks of the surfaces it meets lean on its
   // edges. If most of its points lie on a plane of the known normal within their noise, that
   // plane, with one parameter fewer, is the better model.
-  const Eigen::Vector3d* closest = closestKnownNormal(normal, map_planes, planes);
-  if (!closest || blocks.empty()) return false;
-  const Eigen::Vector3d known = closest->dot(normal) >= 0.0 ? *closest : Eigen::Vector3d(-*closest);
+  if (blocks.empty()) return false;
+  PointMoments piece;
+  for (int b : blocks) piece.add(frame_.moments(b));
+  const Eigen::Vector3d* known_normal =
+      knownNormalFor(normal, frame_.camera_to_world * piece.mean(), map_planes, planes);
+  if (!known_normal) return false;
+  const Eigen::Vector3d known = known_normal->dot(normal) >= 0.0 ? *known_normal : Eigen::Vector3d(-*known_normal);
   const Eigen::Vector3d n_cam = frame_.normalInCamera(known);
   // The offset most points agree on (a median: the leaning blocks are outliers), then the
   // blocks within three of their sigmas of it.

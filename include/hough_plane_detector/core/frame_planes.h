@@ -116,9 +116,12 @@ private:
   // True when the normal's standard error (normalUncertainty of the blocks) is at most
   // merge_angle / 2: within merge_angle at two sigmas.
   bool normalDetermined(double normal_sigma) const;
-  // The normal of the map's or this frame's planes closest to `normal` within snap_angle, or nullptr.
-  const Eigen::Vector3d* closestKnownNormal(const Eigen::Vector3d& normal, const std::vector<DetectedPlane>& map_planes,
-                                            const std::vector<FramePlane>& planes) const;
+  // The normal of a known plane (the map's, or this frame's) within snap_angle of `normal`: of
+  // the closest in angle that passes within merge_distance of `centroid` (world frame), the
+  // piece's, if any, else of the closest; nullptr when none is within snap_angle.
+  const Eigen::Vector3d* knownNormalFor(const Eigen::Vector3d& normal, const Eigen::Vector3d& centroid,
+                                        const std::vector<DetectedPlane>& map_planes,
+                                        const std::vector<FramePlane>& planes) const;
 
   const DetectorParams& params_;
   const HoughParameterization& param_;
