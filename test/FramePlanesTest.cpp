@@ -87,3 +87,37 @@ TEST(FramePlaneFitter, ASnapPrefersTheKnownPlaneThePieceLiesOn)
   EXPECT_LT(angleBetween(normal, wall.normal), 1e-9) << "the wall's normal, the plane the piece lies on";
   EXPECT_NEAR(std::abs(d), std::abs(wall.d), 0.02);
 }
+
+// A table's top 3 m away, 45 cm below the camera, grown as a region with the floor known: rim
+// blocks at its far edge lean over it, its own fit tilts and it takes the floor's normal. The
+// snapped plane is measured by the blocks on it (its whole region's centroids lie off it beyond
+// their noise), and those fit it: one frame is a complete measurement of it (first sight).
+TEST(FramePlaneFitter, ASnappedPlaneIsJudgedOnTheBlocksThatMeasuredIt)
+{
+  Scene scene;
+  scene.addRectangle(Eigen::Vector3d(3, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5, 3, "floor");
+  scene.addBox(Eigen::Vector3d(3.0, 0.0, 0.73), Eigen::Vector3d(0.4, 0.7, 0.02), 0.3, "table");
+  Frame f(scene, lookAt(Eigen::Vector3d(0, 0, 1.2), Eigen::Vector3d(3.0, 0, 0.0)));
+  FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
+  const TruePlane& floor = f.renderer.truePlanes()[f.truePlane("floor")];
+  const TruePlane& top = f.renderer.truePlanes()[f.truePlane("table_top")];
+  DetectedPlane known_floor;
+  known_floor.normal = floor.normal;
+  known_floor.d = floor.d;
+  std::vector<FramePlane> planes;
+  std::vector<PlaneCandidate> candidates;
+  fitter.growRegions({f.peakOf(top)}, {known_floor}, planes, candidates);
+  const FramePlane* table_top = nullptr;
+  for (const FramePlane& plane : planes)
+    if (angleBetween(plane.normal, top.normal) < 0.01 && std::abs(std::abs(plane.d) - std::abs(top.d)) < 0.01)
+      table_top = &plane;
+  ASSERT_NE(table_top, nullptr);
+  ASSERT_TRUE(table_top->parallel) << "the table's top takes the floor's normal";
+  EXPECT_LT(angleBetween(table_top->normal, floor.normal), 1e-9);
+  ASSERT_GT(f.tests.centroidChi2(f.frame.normalInCamera(table_top->normal),
+                                 f.frame.dInCamera(table_top->normal, table_top->d), table_top->blocks),
+            1.0)
+      << "the whole region must lie off the plane beyond its noise, or the test shows nothing";
+  EXPECT_TRUE(table_top->fits_its_blocks);
+  EXPECT_FALSE(table_top->mixes_surfaces);
+}

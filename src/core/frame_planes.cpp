@@ -191,8 +191,9 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
       grower.wholeFacePlane(region, frame_.block_claim, params_.merge_angle, region.normal, region.d);
     Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
     double d = frame_.dInWorld(normal, region.d);
-    const bool snapped =
-        verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, region.blocks, map_planes, planes);
+    std::vector<int> snap_blocks;
+    const bool snapped = verdict == CandidateVerdict::kAccepted &&
+                         snapToKnownDirection(normal, d, region.blocks, map_planes, planes, &snap_blocks);
     // Computed once: the orientation test and the accepted plane's record both need it.
     const double normal_sigma = verdict == CandidateVerdict::kAccepted ? tests_.normalUncertainty(region.blocks) : 0.0;
     if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(normal_sigma))
@@ -204,7 +205,9 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
       for (int b : region.blocks) frame_.block_claim[b] = 1;
     if (verdict != CandidateVerdict::kAccepted) return;
     for (int b : region.blocks) frame_.block_claim[b] = 1;
-    planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks, normal_sigma));
+    // A snapped plane is measured by the blocks on it, not by the rim blocks whose lean it undid.
+    planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks, normal_sigma,
+                                 snapped ? snap_blocks : region.blocks));
   };
   constexpr size_t kMinSeedBlocks = 2;
   for (const HoughPeak& peak : peaks)
@@ -237,7 +240,8 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
 }
 
 FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d, double value, double support,
-                                         bool parallel, const std::vector<int>& blocks, double normal_sigma) const
+                                         bool parallel, const std::vector<int>& blocks, double normal_sigma,
+                                         const std::vector<int>& measured_by) const
 {
   FramePlane plane;
   plane.normal = normal;
@@ -249,7 +253,7 @@ FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d
   plane.first_sight_points = tests_.firstSightPoints(blocks);
   plane.blocks = blocks;
   plane.normal_sigma = normal_sigma;
-  testFitToBlocks(plane, blocks);
+  testFitToBlocks(plane, measured_by);
   describeMeasurement(plane, blocks);
   return plane;
 }
@@ -337,7 +341,7 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
         continue;
       const Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
       kept = regionPlane(normal, frame_.dInWorld(normal, region.d), std::max(kept.value, other.value), moments.count,
-                         false, region.blocks, normal_sigma);
+                         false, region.blocks, normal_sigma, region.blocks);
       planes.erase(planes.begin() + pair.second);
       merged = true;
       break;  // indices moved: list the touching pairs again
@@ -403,7 +407,8 @@ const Eigen::Vector3d* FramePlaneFitter::knownNormalFor(const Eigen::Vector3d& n
 
 bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
                                             const std::vector<DetectedPlane>& map_planes,
-                                            const std::vector<FramePlane>& planes) const
+                                            const std::vector<FramePlane>& planes,
+                                            std::vector<int>* measured_by) const
 {
   // A small or far plane nearly parallel to a known one (a stair tread to the floor, a shelf
   // top) is fitted with a tilt of a few degrees: blocks of the surfaces it meets lean on its
@@ -455,6 +460,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   if (!explained.with_oriented_rim && normalDetermined(tests_.normalUncertainty(inliers))) return false;
   normal = known;
   d = frame_.dInWorld(known, d_cam);
+  if (measured_by) *measured_by = std::move(inliers);
   return true;
 }
 

@@ -58,7 +58,8 @@ struct FramePlane
   // The standard error of its normal (rad) from its blocks; 0 when unknown.
   double normal_sigma = 0.0;
   // Its blocks lie on it within their noise and its interior's own plane agrees with it: a
-  // region leaning over a fold or a curve fails (the first-sight report, plane_map.cpp).
+  // region leaning over a fold or a curve fails (the first-sight report, plane_map.cpp). A
+  // snapped plane is judged on the blocks the snap measured it with.
   bool fits_its_blocks = false;
   // Its blocks' centroids lie off it beyond their noise (p = 0.01, noiseBoundOfMeanChi2): it
   // took blocks of another surface or bends, so one frame does not report it (plane_map.cpp).
@@ -90,9 +91,11 @@ public:
                                   std::vector<int>& blocks, bool tight = false);
   // Gives an accepted plane within snap_angle of a known plane (the map's, or this frame's in
   // `planes`) that normal, and the offset its blocks agree on, when most of its points lie
-  // on that parallel plane within their noise and the likelihood-ratio test allows. True if it did.
+  // on that parallel plane within their noise and the likelihood-ratio test allows. True if it
+  // did; then `measured_by`, when given, holds the blocks on that plane that measured its offset.
   bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
-                            const std::vector<DetectedPlane>& map_planes, const std::vector<FramePlane>& planes) const;
+                            const std::vector<DetectedPlane>& map_planes, const std::vector<FramePlane>& planes,
+                            std::vector<int>* measured_by = nullptr) const;
 
 private:
   // The paper's refinement: up to three passes of taking the unclaimed windows near the
@@ -109,8 +112,10 @@ private:
   void testFitToBlocks(FramePlane& plane, const std::vector<int>& blocks) const;
   // A region's accepted plane (world frame) as the map receives it; normal_sigma is
   // PlanarityTests::normalUncertainty of its blocks, which the caller has already computed.
+  // Its fit is tested on `measured_by`: the blocks, or for a snapped plane the snap's.
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
-                         const std::vector<int>& blocks, double normal_sigma) const;
+                         const std::vector<int>& blocks, double normal_sigma,
+                         const std::vector<int>& measured_by) const;
   // Joins touching regions of this frame that the region tests accept as one plane.
   void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const;
   // True when the normal's standard error (normalUncertainty of the blocks) is at most
