@@ -388,7 +388,6 @@ const Eigen::Vector3d* FramePlaneFitter::knownNormalFor(const Eigen::Vector3d& n
   double closest_angle = params_.snap_angle, closest_on_angle = params_.snap_angle;
   auto consider = [&](const Eigen::Vector3d& known_normal, double known_d) {
     const double angle = unsignedAngle(known_normal, normal);
-    if (angle >= closest_angle && angle >= closest_on_angle) return;
     if (angle < closest_angle)
     {
       closest_angle = angle;
