@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <set>
 #include <utility>
 
@@ -176,14 +177,40 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
   // the weaker peaks. Then every flat block left seeds a region of its own plane: faces too
   // small for a window's vote (box sides, far shelves) are still planes of the frame.
   frame_.block_claim.assign(frame_.blocks.size(), 0);
+  split_pairs_.clear();
   std::vector<char> tried(frame_.blocks.size(), 0);
   BlockRegionGrower grower(frame_.normals, frame_.blocks, params_);
+  std::function<void(PlaneRegion&, CandidateVerdict, PointMoments&, double)> keep;
   auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
     PlaneRegion region = grower.grow(seed, n_cam, d_cam, frame_.block_claim);
     for (int b : region.blocks) tried[b] = 1;
     for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
     PointMoments moments;
     CandidateVerdict verdict = testRegion(grower, region, moments);
+    // A region over two surfaces is kept as the two planes it splits into; the merge below
+    // leaves that pair apart (split_pairs_, by each plane's first block, which a merge keeps).
+    std::vector<int> first, second;
+    if (verdict == CandidateVerdict::kAccepted && splitMixedRegion(grower, region, first, second))
+    {
+      const size_t before = planes.size();
+      for (std::vector<int>* part : {&first, &second})
+      {
+        PlaneRegion piece;
+        piece.blocks.swap(*part);
+        grower.fit(piece.blocks, piece.normal, piece.d);
+        for (int b : piece.blocks) piece.points += frame_.points(b);
+        PointMoments piece_moments;
+        const CandidateVerdict piece_verdict = testRegion(grower, piece, piece_moments);
+        keep(piece, piece_verdict, piece_moments, peak_value);
+      }
+      if (planes.size() == before + 2)
+        split_pairs_.emplace(std::min(planes[before].blocks[0], planes[before + 1].blocks[0]),
+                             std::max(planes[before].blocks[0], planes[before + 1].blocks[0]));
+      return;
+    }
+    keep(region, verdict, moments, peak_value);
+  };
+  keep = [&](PlaneRegion& region, CandidateVerdict verdict, PointMoments& moments, double peak_value) {
     // The plane of the whole face, bowed edges included, as a least-squares fit to it would be.
     // The region keeps the blocks it was tested on: claiming the bowed edges too moved later
     // regions' seeds and added false planes on rendered scenes.
@@ -326,6 +353,8 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
       const FramePlane& other = planes[pair.second];
       if (kept.parallel || other.parallel || unsignedAngle(kept.normal, other.normal) > 2.0 * params_.merge_angle)
         continue;
+      if (split_pairs_.count({std::min(kept.blocks[0], other.blocks[0]), std::max(kept.blocks[0], other.blocks[0])}))
+        continue;
       PlaneRegion region;
       region.blocks = kept.blocks;
       region.blocks.insert(region.blocks.end(), other.blocks.begin(), other.blocks.end());
@@ -347,6 +376,93 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
       break;  // indices moved: list the touching pairs again
     }
   }
+}
+
+bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const PlaneRegion& region,
+                                        std::vector<int>& first, std::vector<int>& second) const
+{
+  // A region that drifted over two surfaces meeting at an edge (two stacked boxes' backs a few
+  // degrees apart) lies off its plane beyond its blocks' noise. Two planes fitted by
+  // alternating assignment (each block to the plane nearer it), started from the region's
+  // halves along each of its axes, explain it when each part, connected, lies on its own plane
+  // within that noise.
+  const std::vector<int>& blocks = region.blocks;
+  if (blocks.size() < 2 * kMinInteriorBlocks) return false;
+  if (tests_.centroidChi2(region.normal, region.d, blocks) <= noiseBoundOfMeanChi2(blocks.size())) return false;
+  const int bx_count = frame_.blocksX(), by_count = frame_.blocksY();
+  // The largest 4-connected component of a part: blocks near the line where the two planes
+  // cross lie on both within their noise and may be assigned across it.
+  auto largestComponent = [&](const std::vector<int>& part) {
+    std::vector<int> sorted = part, best;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<char> seen(sorted.size(), 0);
+    for (size_t start = 0; start < sorted.size(); ++start)
+    {
+      if (seen[start]) continue;
+      std::vector<int> component{sorted[start]};
+      seen[start] = 1;
+      for (size_t head = 0; head < component.size(); ++head)
+        forEachNeighbour(component[head], bx_count, by_count, [&](int nb) {
+          const auto it = std::lower_bound(sorted.begin(), sorted.end(), nb);
+          if (it == sorted.end() || *it != nb || seen[it - sorted.begin()]) return;
+          seen[it - sorted.begin()] = 1;
+          component.push_back(nb);
+        });
+      if (component.size() > best.size()) best.swap(component);
+    }
+    return best;
+  };
+  // Alternating assignment from a first split; the parts' summed chi^2 when both fit, else none.
+  auto refine = [&](std::vector<int>& a, std::vector<int>& b) {
+    constexpr int kMaxIterations = 10;
+    Eigen::Vector3d n_a = region.normal, n_b = region.normal;
+    double d_a = region.d, d_b = region.d;
+    for (int iteration = 0; iteration <= kMaxIterations; ++iteration)
+    {
+      if (a.size() < kMinInteriorBlocks || b.size() < kMinInteriorBlocks) return -1.0;
+      if (!grower.fit(a, n_a, d_a) || !grower.fit(b, n_b, d_b)) return -1.0;
+      std::vector<int> next_a, next_b;
+      for (int block : blocks)
+      {
+        const Eigen::Vector3d& c = frame_.blocks[block].centroid;
+        (std::abs(n_a.dot(c) + d_a) <= std::abs(n_b.dot(c) + d_b) ? next_a : next_b).push_back(block);
+      }
+      if (next_a == a) break;
+      a.swap(next_a);
+      b.swap(next_b);
+    }
+    if (!grower.fit(a, n_a, d_a) || !grower.fit(b, n_b, d_b)) return -1.0;
+    const double chi2_a = tests_.centroidChi2(n_a, d_a, a), chi2_b = tests_.centroidChi2(n_b, d_b, b);
+    if (chi2_a > noiseBoundOfMeanChi2(a.size()) || chi2_b > noiseBoundOfMeanChi2(b.size())) return -1.0;
+    // Each part must be one piece of surface, give or take the tenth of its blocks near the
+    // planes' crossing, which lie on both within their noise.
+    constexpr double kMinConnectedShare = 0.9;
+    std::vector<int> main_a = largestComponent(a), main_b = largestComponent(b);
+    if (main_a.size() < kMinConnectedShare * a.size() || main_b.size() < kMinConnectedShare * b.size()) return -1.0;
+    a.swap(main_a);
+    b.swap(main_b);
+    return chi2_a * a.size() + chi2_b * b.size();
+  };
+  PointMoments centroids;
+  for (int block : blocks) centroids.add(centroidMoments(frame_.moments(block)));
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(centroids.covariance());
+  const Eigen::Vector3d mean = centroids.mean();
+  double best = -1.0;
+  for (int axis = 1; axis <= 2; ++axis)
+  {
+    const Eigen::Vector3d along = solver.eigenvectors().col(axis);
+    std::vector<int> a, b;
+    for (int block : blocks) (along.dot(frame_.blocks[block].centroid - mean) >= 0.0 ? a : b).push_back(block);
+    const double chi2 = refine(a, b);
+    if (chi2 >= 0.0 && (best < 0.0 || chi2 < best))
+    {
+      best = chi2;
+      first.swap(a);
+      second.swap(b);
+    }
+  }
+  return best >= 0.0;
 }
 
 CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, PlaneRegion& region,

@@ -3,6 +3,8 @@
 // the planarity tests pass; a plane a few degrees off a known one may take its normal.
 #pragma once
 
+#include <set>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -105,6 +107,10 @@ private:
                                    PointMoments& weighted);
   // The planarity tests of a grown region, in order; the flat components' moments in `moments`.
   CandidateVerdict testRegion(const BlockRegionGrower& grower, PlaneRegion& region, PointMoments& moments) const;
+  // A region whose blocks lie off its plane beyond their noise, split into two connected parts
+  // that each lie on their own plane within it; false when no such split exists.
+  bool splitMixedRegion(const BlockRegionGrower& grower, const PlaneRegion& region, std::vector<int>& first,
+                        std::vector<int>& second) const;
   // Sets the plane's centroid and offset error from the blocks that measured it.
   void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
   // FramePlane::fits_its_blocks and mixes_surfaces: how the blocks' centroids, and the interior's
@@ -134,6 +140,7 @@ private:
   const PlanarityTests& tests_;
   std::vector<int> block_mark_;  // scratch of collectPlaneBlocks
   int mark_generation_ = 0;
+  std::set<std::pair<int, int>> split_pairs_;  // planes of one split region, by their first blocks
 };
 
 }  // namespace hough_plane_detector
