@@ -50,18 +50,6 @@ sensor_msgs::PointCloud2 goodCloud(int width = 640, int height = 480)
   return msg;
 }
 
-// `count` good clouds stamped now, 0.3 s apart.
-void publishGoodClouds(ros::Publisher& pub, int count)
-{
-  for (int i = 0; i < count; ++i)
-  {
-    sensor_msgs::PointCloud2 good = goodCloud();
-    good.header.stamp = ros::Time::now();
-    pub.publish(good);
-    ros::WallDuration(0.3).sleep();
-  }
-}
-
 size_t arrayCount()
 {
   std::lock_guard<std::mutex> lock(mutex);
@@ -94,6 +82,38 @@ bool waitFor(double seconds, const std::function<bool()>& done)
   }
   return done();
 }
+
+// Good clouds (stamped `age` seconds ago) every 0.3 s until `done`: the first may arrive before
+// the node's tf buffer holds the static camera transform (or, after a reset, holds it again)
+// and be skipped, so no fixed wait can be long enough on a loaded machine.
+// A cloud published just before `done` held may still be on its way: it returns once no plane
+// array has arrived for a second.
+bool publishGoodCloudsUntil(ros::Publisher& pub, double seconds, const std::function<bool()>& done, double age = 0.0)
+{
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  bool met = false;
+  while (!met && ros::WallTime::now() < end)
+  {
+    sensor_msgs::PointCloud2 good = goodCloud();
+    good.header.stamp = ros::Time::now() - ros::Duration(age);
+    pub.publish(good);
+    met = waitFor(0.3, done);
+  }
+  size_t count = arrayCount();
+  ros::WallTime last_change = ros::WallTime::now();
+  while (ros::WallTime::now() - last_change < ros::WallDuration(1.0) && ros::WallTime::now() < end + ros::WallDuration(10.0))
+  {
+    ros::WallDuration(0.05).sleep();
+    if (arrayCount() != count) count = arrayCount(), last_change = ros::WallTime::now();
+  }
+  return met || done();
+}
+
+bool wallInMap()
+{
+  std::lock_guard<std::mutex> lock(mutex);
+  return !arrays.empty() && arrays.back()->planes.size() == 1;
+}
 }  // namespace
 
 TEST(BadInput, RefusedClouds)
@@ -101,20 +121,28 @@ TEST(BadInput, RefusedClouds)
   ros::NodeHandle nh;
   ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("/bad_input/points", 20);
   ASSERT_TRUE(waitFor(20.0, [&] { return pub.getNumSubscribers() > 0; }));
-  ros::WallDuration(1.0).sleep();  // the static transform reaches the node's buffer
 
-  // Three good frames: the wall is in the map.
-  publishGoodClouds(pub, 3);
-  ASSERT_TRUE(waitFor(10.0, [&] {
-    std::lock_guard<std::mutex> lock(mutex);
-    return !arrays.empty() && arrays.back()->planes.size() == 1;
-  })) << "the wall was not found from good clouds";
+  // Good frames until three were processed and the wall is in the map.
+  ASSERT_TRUE(publishGoodCloudsUntil(pub, 20.0, [&] { return diagnosticInt("frames processed") >= 3 && wallInMap(); }))
+      << "the wall was not found from good clouds";
   PlaneArray before;
   {
     std::lock_guard<std::mutex> lock(mutex);
     before = *arrays.back();
   }
   const size_t published_before = arrayCount();
+  // Good clouds that came before the static transform were skipped: counted from the second
+  // diagnostics report after the wall (the first may predate a skip).
+  size_t reports = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    reports = diagnostics.size();
+  }
+  ASSERT_TRUE(waitFor(10.0, [&] {
+    std::lock_guard<std::mutex> lock(mutex);
+    return diagnostics.size() >= reports + 2;
+  })) << "no diagnostics";
+  const int skipped_before = diagnosticInt("frames skipped (no transform)");
 
   std::vector<std::pair<std::string, sensor_msgs::PointCloud2>> bad;
   sensor_msgs::PointCloud2 c = goodCloud();
@@ -178,8 +206,8 @@ TEST(BadInput, RefusedClouds)
   pub.publish(c);
   c.header.frame_id = "";
   pub.publish(c);
-  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticValue("frames skipped (no transform)") == "2"; }))
-      << "skipped count " << diagnosticValue("frames skipped (no transform)");
+  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames skipped (no transform)") == skipped_before + 2; }))
+      << "skipped count " << diagnosticValue("frames skipped (no transform)") << ", " << skipped_before << " before";
 }
 
 // odom -> camera as the static publisher of the launch file gives it, under another child name.
@@ -203,13 +231,7 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   ros::NodeHandle nh;
   ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("/bad_input/points", 20);
   ASSERT_TRUE(waitFor(20.0, [&] { return pub.getNumSubscribers() > 0; }));
-  ros::WallDuration(1.0).sleep();
-  publishGoodClouds(pub, 2);
-  ASSERT_TRUE(waitFor(10.0, [&] {
-    if (diagnosticInt("frames processed") < 2) return false;
-    std::lock_guard<std::mutex> lock(mutex);
-    return !arrays.empty() && arrays.back()->planes.size() == 1;
-  }));
+  ASSERT_TRUE(publishGoodCloudsUntil(pub, 20.0, [&] { return diagnosticInt("frames processed") >= 2 && wallInMap(); }));
   PlaneArray before;
   {
     std::lock_guard<std::mutex> lock(mutex);
@@ -252,11 +274,9 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   pub.publish(c);
   EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("time jumps back (tf reset)") == 1; }))
       << "jumps " << diagnosticValue("time jumps back (tf reset)");
-  ros::WallDuration(1.0).sleep();
   const int processed = diagnosticInt("frames processed");
-  c.header.stamp = ros::Time::now() - ros::Duration(29.0);
-  pub.publish(c);
-  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames processed") >= processed + 1; }))
+  EXPECT_TRUE(publishGoodCloudsUntil(
+      pub, 15.0, [&] { return diagnosticInt("frames processed") >= processed + 1; }, 29.0))
       << "clouds after the tf reset were not processed";
   {
     std::lock_guard<std::mutex> lock(mutex);

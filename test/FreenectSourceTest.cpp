@@ -87,9 +87,11 @@ TEST(FreenectSource, AFakenectRecordingOfARoomGivesItsPlanes)
   sensor_msgs::Image::ConstPtr image;
   sensor_msgs::CameraInfo::ConstPtr info;
   ros::NodeHandle nh;
+  ros::WallTime last_planes;
   ros::Subscriber planes_sub = nh.subscribe<PlaneArray>("/hough_plane_detector/planes", 10, [&](const PlaneArray::ConstPtr& m) {
     std::lock_guard<std::mutex> lock(mutex);
     planes = m;
+    last_planes = ros::WallTime::now();
   });
   ros::Subscriber image_sub = nh.subscribe<sensor_msgs::Image>("/camera/depth/image_raw", 10, [&](const sensor_msgs::Image::ConstPtr& m) {
     std::lock_guard<std::mutex> lock(mutex);
@@ -108,7 +110,14 @@ TEST(FreenectSource, AFakenectRecordingOfARoomGivesItsPlanes)
                         "registration data)"),
             std::string::npos)
       << output;
-  ros::WallDuration(1.0).sleep();
+  // The last frames' plane arrays: until all three topics were heard and the planes have been
+  // quiet for half a second (the source has ended), 10 s at most.
+  waitUntil(
+      [&] {
+        std::lock_guard<std::mutex> lock(mutex);
+        return image && info && planes && ros::WallTime::now() - last_planes > ros::WallDuration(0.5);
+      },
+      10.0);
 
   std::lock_guard<std::mutex> lock(mutex);
   ASSERT_TRUE(image) << "no depth/image_raw\n" << output;
