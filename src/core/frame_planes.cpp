@@ -384,8 +384,8 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
   // A region that drifted over two surfaces meeting at an edge (two stacked boxes' backs a few
   // degrees apart) lies off its plane beyond its blocks' noise. Two planes fitted by
   // alternating assignment (each block to the plane nearer it), started from the region's
-  // halves along each of its axes, explain it when each part, connected, lies on its own plane
-  // within that noise.
+  // halves along each of its two in-plane axes, explain it when each part, connected, lies on
+  // its own plane within that noise. The parts are returned without their stray blocks.
   const std::vector<int>& blocks = region.blocks;
   if (blocks.size() < 2 * kMinInteriorBlocks) return false;
   if (tests_.centroidChi2(region.normal, region.d, blocks) <= noiseBoundOfMeanChi2(blocks.size())) return false;
@@ -439,9 +439,10 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
     constexpr double kMinConnectedShare = 0.9;
     std::vector<int> main_a = largestComponent(a), main_b = largestComponent(b);
     if (main_a.size() < kMinConnectedShare * a.size() || main_b.size() < kMinConnectedShare * b.size()) return -1.0;
+    const double total_chi2 = chi2_a * a.size() + chi2_b * b.size();  // of the whole region, as split
     a.swap(main_a);
     b.swap(main_b);
-    return chi2_a * a.size() + chi2_b * b.size();
+    return total_chi2;
   };
   PointMoments centroids;
   for (int block : blocks) centroids.add(centroidMoments(frame_.moments(block)));
