@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <set>
 #include <utility>
 
@@ -177,40 +176,13 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
   // the weaker peaks. Then every flat block left seeds a region of its own plane: faces too
   // small for a window's vote (box sides, far shelves) are still planes of the frame.
   frame_.block_claim.assign(frame_.blocks.size(), 0);
-  split_pairs_.clear();
+  split_group_.assign(planes.size(), -1);
+  int split_count = 0;
   std::vector<char> tried(frame_.blocks.size(), 0);
   BlockRegionGrower grower(frame_.normals, frame_.blocks, params_);
-  std::function<void(PlaneRegion&, CandidateVerdict, PointMoments&, double)> keep;
-  auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
-    PlaneRegion region = grower.grow(seed, n_cam, d_cam, frame_.block_claim);
-    for (int b : region.blocks) tried[b] = 1;
-    for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
-    PointMoments moments;
-    CandidateVerdict verdict = testRegion(grower, region, moments);
-    // A region over two surfaces is kept as the two planes it splits into; the merge below
-    // leaves that pair apart (split_pairs_, by each plane's first block, which a merge keeps).
-    std::vector<int> first, second;
-    if (verdict == CandidateVerdict::kAccepted && splitMixedRegion(grower, region, first, second))
-    {
-      const size_t before = planes.size();
-      for (std::vector<int>* part : {&first, &second})
-      {
-        PlaneRegion piece;
-        piece.blocks.swap(*part);
-        grower.fit(piece.blocks, piece.normal, piece.d);
-        for (int b : piece.blocks) piece.points += frame_.points(b);
-        PointMoments piece_moments;
-        const CandidateVerdict piece_verdict = testRegion(grower, piece, piece_moments);
-        keep(piece, piece_verdict, piece_moments, peak_value);
-      }
-      if (planes.size() == before + 2)
-        split_pairs_.emplace(std::min(planes[before].blocks[0], planes[before + 1].blocks[0]),
-                             std::max(planes[before].blocks[0], planes[before + 1].blocks[0]));
-      return;
-    }
-    keep(region, verdict, moments, peak_value);
-  };
-  keep = [&](PlaneRegion& region, CandidateVerdict verdict, PointMoments& moments, double peak_value) {
+  // An accepted region's plane, snapped or not, joins `planes`; a refused one is a candidate only.
+  int split_group = -1;  // the number of the split whose parts are being kept, else -1
+  auto keep = [&](PlaneRegion& region, CandidateVerdict verdict, PointMoments& moments, double peak_value) {
     // The plane of the whole face, bowed edges included, as a least-squares fit to it would be.
     // The region keeps the blocks it was tested on: claiming the bowed edges too moved later
     // regions' seeds and added false planes on rendered scenes.
@@ -235,6 +207,34 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     // A snapped plane is measured by the blocks on it, not by the rim blocks whose lean it undid.
     planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks, normal_sigma,
                                  snapped ? snap_blocks : region.blocks));
+    split_group_.push_back(split_group);
+  };
+  auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
+    PlaneRegion region = grower.grow(seed, n_cam, d_cam, frame_.block_claim);
+    for (int b : region.blocks) tried[b] = 1;
+    for (int b : region.trimmed) tried[b] = 1;  // near this plane: no seeds of a twin
+    PointMoments moments;
+    CandidateVerdict verdict = testRegion(grower, region, moments);
+    // A region over two surfaces is kept as the two planes it splits into; the merge below
+    // leaves that pair apart (split_group_).
+    std::vector<int> first, second;
+    if (verdict == CandidateVerdict::kAccepted && splitMixedRegion(grower, region, first, second))
+    {
+      split_group = split_count++;
+      for (std::vector<int>* part : {&first, &second})
+      {
+        PlaneRegion piece;
+        piece.blocks.swap(*part);
+        grower.fit(piece.blocks, piece.normal, piece.d);
+        for (int b : piece.blocks) piece.points += frame_.points(b);
+        PointMoments piece_moments;
+        const CandidateVerdict piece_verdict = testRegion(grower, piece, piece_moments);
+        keep(piece, piece_verdict, piece_moments, peak_value);
+      }
+      split_group = -1;
+      return;
+    }
+    keep(region, verdict, moments, peak_value);
   };
   constexpr size_t kMinSeedBlocks = 2;
   for (const HoughPeak& peak : peaks)
@@ -320,7 +320,7 @@ void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<
   plane.offset_sigma = std::sqrt(1.0 / information + kCentroidFloor);
 }
 
-void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const
+void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes)
 {
   // Two touching regions whose normals the map would keep apart are one plane when their union
   // passes the region tests and each part lies on the union's plane within its noise: a box
@@ -353,8 +353,7 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
       const FramePlane& other = planes[pair.second];
       if (kept.parallel || other.parallel || unsignedAngle(kept.normal, other.normal) > 2.0 * params_.merge_angle)
         continue;
-      if (split_pairs_.count({std::min(kept.blocks[0], other.blocks[0]), std::max(kept.blocks[0], other.blocks[0])}))
-        continue;
+      if (split_group_[pair.first] >= 0 && split_group_[pair.first] == split_group_[pair.second]) continue;
       PlaneRegion region;
       region.blocks = kept.blocks;
       region.blocks.insert(region.blocks.end(), other.blocks.begin(), other.blocks.end());
@@ -372,6 +371,7 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
       kept = regionPlane(normal, frame_.dInWorld(normal, region.d), std::max(kept.value, other.value), moments.count,
                          false, region.blocks, normal_sigma, region.blocks);
       planes.erase(planes.begin() + pair.second);
+      split_group_.erase(split_group_.begin() + pair.second);
       merged = true;
       break;  // indices moved: list the touching pairs again
     }

@@ -3,8 +3,6 @@
 // the planarity tests pass; a plane a few degrees off a known one may take its normal.
 #pragma once
 
-#include <set>
-#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -122,8 +120,9 @@ private:
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
                          const std::vector<int>& blocks, double normal_sigma,
                          const std::vector<int>& measured_by) const;
-  // Joins touching regions of this frame that the region tests accept as one plane.
-  void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const;
+  // Joins touching regions of this frame that the region tests accept as one plane, but not the
+  // two parts of a split region (split_group_).
+  void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes);
   // True when the normal's standard error (normalUncertainty of the blocks) is at most
   // merge_angle / 2: within merge_angle at two sigmas.
   bool normalDetermined(double normal_sigma) const;
@@ -140,7 +139,8 @@ private:
   const PlanarityTests& tests_;
   std::vector<int> block_mark_;  // scratch of collectPlaneBlocks
   int mark_generation_ = 0;
-  std::set<std::pair<int, int>> split_pairs_;  // planes of one split region, by their first blocks
+  // Per plane of growRegions' `planes`: the number of the split region it is a part of, or -1.
+  std::vector<int> split_group_;
 };
 
 }  // namespace hough_plane_detector
