@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <mutex>
 
@@ -14,6 +15,7 @@
 #include "hough_plane_detector/PlaneArray.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
 #include "reconfigure_request.h"
+#include "wait_until.h"
 
 using namespace hough_plane_detector;
 
@@ -72,17 +74,6 @@ int diagnosticInt(const std::string& key)
   return value.empty() ? -1 : std::stoi(value);
 }
 
-bool waitFor(double seconds, const std::function<bool()>& done)
-{
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::WallTime::now() < end)
-  {
-    if (done()) return true;
-    ros::WallDuration(0.05).sleep();
-  }
-  return done();
-}
-
 // Good clouds (stamped `age` seconds ago) every 0.3 s until `done`: the first may arrive before
 // the node's tf buffer holds the static camera transform (or, after a reset, holds it again)
 // and be skipped, so no fixed wait can be long enough on a loaded machine.
@@ -97,7 +88,7 @@ bool publishGoodCloudsUntil(ros::Publisher& pub, double seconds, const std::func
     sensor_msgs::PointCloud2 good = goodCloud();
     good.header.stamp = ros::Time::now() - ros::Duration(age);
     pub.publish(good);
-    met = waitFor(0.3, done);
+    met = test::waitUntil(done, 0.3);
   }
   size_t count = arrayCount();
   ros::WallTime last_change = ros::WallTime::now();
@@ -120,7 +111,7 @@ TEST(BadInput, RefusedClouds)
 {
   ros::NodeHandle nh;
   ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("/bad_input/points", 20);
-  ASSERT_TRUE(waitFor(20.0, [&] { return pub.getNumSubscribers() > 0; }));
+  ASSERT_TRUE(test::waitUntil([&] { return pub.getNumSubscribers() > 0; }, 20.0));
 
   // Good frames until three were processed and the wall is in the map.
   ASSERT_TRUE(publishGoodCloudsUntil(pub, 20.0, [&] { return diagnosticInt("frames processed") >= 3 && wallInMap(); }))
@@ -138,10 +129,10 @@ TEST(BadInput, RefusedClouds)
     std::lock_guard<std::mutex> lock(mutex);
     reports = diagnostics.size();
   }
-  ASSERT_TRUE(waitFor(10.0, [&] {
+  ASSERT_TRUE(test::waitUntil([&] {
     std::lock_guard<std::mutex> lock(mutex);
     return diagnostics.size() >= reports + 2;
-  })) << "no diagnostics";
+  }, 10.0)) << "no diagnostics";
   const int skipped_before = diagnosticInt("frames skipped (no transform)");
 
   std::vector<std::pair<std::string, sensor_msgs::PointCloud2>> bad;
@@ -172,7 +163,7 @@ TEST(BadInput, RefusedClouds)
     pub.publish(entry.second);
     ros::WallDuration(0.2).sleep();
   }
-  EXPECT_TRUE(waitFor(10.0, [&] { return diagnosticValue("frames refused (bad cloud)") == std::to_string(bad.size()); }))
+  EXPECT_TRUE(test::waitUntil([&] { return diagnosticValue("frames refused (bad cloud)") == std::to_string(bad.size()); }, 10.0))
       << "refused count " << diagnosticValue("frames refused (bad cloud)");
   EXPECT_EQ(arrayCount(), published_before) << "a refused cloud changed the published map";
 
@@ -190,7 +181,7 @@ TEST(BadInput, RefusedClouds)
   c = goodCloud(2048, 1536);
   c.header.stamp = ros::Time::now();
   pub.publish(c);
-  ASSERT_TRUE(waitFor(20.0, [&] { return arrayCount() >= published_before + 2; }));
+  ASSERT_TRUE(test::waitUntil([&] { return arrayCount() >= published_before + 2; }, 20.0));
   {
     std::lock_guard<std::mutex> lock(mutex);
     const PlaneArray& after = *arrays.back();
@@ -206,7 +197,7 @@ TEST(BadInput, RefusedClouds)
   pub.publish(c);
   c.header.frame_id = "";
   pub.publish(c);
-  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames skipped (no transform)") == skipped_before + 2; }))
+  EXPECT_TRUE(test::waitUntil([&] { return diagnosticInt("frames skipped (no transform)") == skipped_before + 2; }, 15.0))
       << "skipped count " << diagnosticValue("frames skipped (no transform)") << ", " << skipped_before << " before";
 }
 
@@ -230,7 +221,7 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   const std::string node = "/hough_plane_detector";
   ros::NodeHandle nh;
   ros::Publisher pub = nh.advertise<sensor_msgs::PointCloud2>("/bad_input/points", 20);
-  ASSERT_TRUE(waitFor(20.0, [&] { return pub.getNumSubscribers() > 0; }));
+  ASSERT_TRUE(test::waitUntil([&] { return pub.getNumSubscribers() > 0; }, 20.0));
   ASSERT_TRUE(publishGoodCloudsUntil(pub, 20.0, [&] { return diagnosticInt("frames processed") >= 2 && wallInMap(); }));
   PlaneArray before;
   {
@@ -250,7 +241,7 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   c.header.frame_id = "camera_nan";
   c.header.stamp = ros::Time::now();
   pub.publish(c);
-  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames skipped (no transform)") >= skipped_before + 1; }))
+  EXPECT_TRUE(test::waitUntil([&] { return diagnosticInt("frames skipped (no transform)") >= skipped_before + 1; }, 15.0))
       << "a cloud behind a NaN transform was not skipped";
 
   // A stale transform: known at t0 only, so clouds stamped later need extrapolation; tf2's
@@ -262,7 +253,7 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   c.header.frame_id = "camera_stale";
   c.header.stamp = t0 + ros::Duration(0.5);
   for (int i = 0; i < 3; ++i) pub.publish(c);
-  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("frames skipped (no transform)") >= skipped_after_nan + 1; }))
+  EXPECT_TRUE(test::waitUntil([&] { return diagnosticInt("frames skipped (no transform)") >= skipped_after_nan + 1; }, 15.0))
       << "no cloud needing extrapolation was counted as skipped";
   EXPECT_EQ(arrayCount(), published_before) << "a cloud without a usable transform changed the map";
 
@@ -272,7 +263,7 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   c = goodCloud();
   c.header.stamp = ros::Time::now() - ros::Duration(30.0);
   pub.publish(c);
-  EXPECT_TRUE(waitFor(15.0, [&] { return diagnosticInt("time jumps back (tf reset)") == 1; }))
+  EXPECT_TRUE(test::waitUntil([&] { return diagnosticInt("time jumps back (tf reset)") == 1; }, 15.0))
       << "jumps " << diagnosticValue("time jumps back (tf reset)");
   const int processed = diagnosticInt("frames processed");
   EXPECT_TRUE(publishGoodCloudsUntil(
@@ -298,7 +289,7 @@ TEST(BadInput, BrokenTransformsTimeJumpsAndOutOfRangeReconfigure)
   c.header.stamp = ros::Time::now() - ros::Duration(28.0);
   const size_t published = arrayCount();
   pub.publish(c);
-  EXPECT_TRUE(waitFor(15.0, [&] { return arrayCount() > published; })) << "the node stopped after reconfigure";
+  EXPECT_TRUE(test::waitUntil([&] { return arrayCount() > published; }, 15.0)) << "the node stopped after reconfigure";
 }
 
 void onPlanes(const PlaneArray::ConstPtr& m)

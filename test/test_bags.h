@@ -24,6 +24,7 @@
 
 #include "hough_plane_detector/ros/depth_camera_publisher.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
+#include "wait_until.h"
 
 namespace hough_plane_detector
 {
@@ -200,20 +201,6 @@ inline int runRosTests(int argc, char** argv, const char* name)
   const int result = RUN_ALL_TESTS();
   spinner.stop();
   return result;
-}
-
-// Polls `done` every 50 ms until it holds or `seconds` (wall time) pass; whether it held. Tests
-// wait on what they need rather than for a fixed time, which a loaded machine can outlast.
-template <class Done>
-bool waitUntil(Done done, double seconds)
-{
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (!done())
-  {
-    if (ros::WallTime::now() > end) return false;
-    ros::WallDuration(0.05).sleep();
-  }
-  return true;
 }
 
 // Whether the master lists at least one subscriber of `topic` (a node that will connect to
