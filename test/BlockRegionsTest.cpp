@@ -125,3 +125,34 @@ TEST(BlockRegions, ABendThatMovesNoPointAMillimetreIsStillAPlane)
     EXPECT_FALSE(curved(bentPatch(0.0, 0.20, 0.05, 0.7), by_normals)) << by_normals;
   }
 }
+
+TEST(BlockComponents, SplitsASetIntoItsFourConnectedPiecesInTheOrderOfTheirFirstBlock)
+{
+  // A 5 x 4 grid: an L of four blocks (A), a pair (B) and a block touching both only across
+  // corners (C).
+  //   . . . . .
+  //   A . . B B
+  //   A . C . .
+  //   A A . . .
+  const int bx = 5, by = 4;
+  const std::vector<int> blocks{8, 9, 5, 10, 15, 16, 12};  // B, then A, then C
+  BlockComponents components;
+  std::vector<std::vector<int>> found;
+  for (int pass = 0; pass < 2; ++pass)  // the marks of the first call must not leak into the second
+  {
+    found.clear();
+    components.forEach(blocks, bx, by, [&](const std::vector<int>& component) {
+      std::vector<int> sorted = component;
+      std::sort(sorted.begin(), sorted.end());
+      found.push_back(sorted);
+    });
+    ASSERT_EQ(found.size(), 3u) << "pass " << pass;
+    EXPECT_EQ(found[0], (std::vector<int>{8, 9}));
+    EXPECT_EQ(found[1], (std::vector<int>{5, 10, 15, 16}));
+    EXPECT_EQ(found[2], (std::vector<int>{12}));
+  }
+  // Two blocks of the L with the one between them left out are two pieces.
+  found.clear();
+  components.forEach({5, 15}, bx, by, [&](const std::vector<int>& component) { found.push_back(component); });
+  EXPECT_EQ(found.size(), 2u);
+}

@@ -296,26 +296,12 @@ bool BlockRegionGrower::fitInterior(const std::vector<int>& blocks, Eigen::Vecto
 std::vector<std::vector<int>> BlockRegionGrower::seedComponents(const Eigen::Vector3d& normal, double d,
                                                                 const std::vector<char>& taken)
 {
-  const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
-  ++generation_;
-  const int member = generation_;
+  std::vector<int> agreeing;
   for (size_t b = 0; b < info_.size(); ++b)
-    if (!taken[b] && accepts(static_cast<int>(b), normal, d)) mark_[b] = member;
-  ++generation_;  // visited
+    if (!taken[b] && accepts(static_cast<int>(b), normal, d)) agreeing.push_back(static_cast<int>(b));
   std::vector<std::vector<int>> components;
-  for (size_t seed = 0; seed < info_.size(); ++seed)
-  {
-    if (mark_[seed] != member) continue;
-    std::vector<int> component(1, static_cast<int>(seed));
-    mark_[seed] = generation_;
-    for (size_t head = 0; head < component.size(); ++head)
-      forEachNeighbour(component[head], bx_count, by_count, [&](int nb) {
-        if (mark_[nb] != member) return;
-        mark_[nb] = generation_;
-        component.push_back(nb);
-      });
-    components.push_back(std::move(component));
-  }
+  components_.forEach(agreeing, grid_.blocksX(), grid_.blocksY(),
+                      [&](const std::vector<int>& component) { components.push_back(component); });
   std::sort(components.begin(), components.end(),
             [](const std::vector<int>& a, const std::vector<int>& b) { return a.size() > b.size(); });
   return components;

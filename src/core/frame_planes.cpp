@@ -383,27 +383,15 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
   const std::vector<int>& blocks = region.blocks;
   if (blocks.size() < 2 * kMinInteriorBlocks) return false;
   if (tests_.centroidChi2(region.normal, region.d, blocks) <= noiseBoundOfMeanChi2(blocks.size())) return false;
-  const int bx_count = frame_.blocksX(), by_count = frame_.blocksY();
   // The largest 4-connected component of a part: blocks near the line where the two planes
   // cross lie on both within their noise and may be assigned across it.
+  BlockComponents components;
   auto largestComponent = [&](const std::vector<int>& part) {
     std::vector<int> sorted = part, best;
     std::sort(sorted.begin(), sorted.end());
-    std::vector<char> seen(sorted.size(), 0);
-    for (size_t start = 0; start < sorted.size(); ++start)
-    {
-      if (seen[start]) continue;
-      std::vector<int> component{sorted[start]};
-      seen[start] = 1;
-      for (size_t head = 0; head < component.size(); ++head)
-        forEachNeighbour(component[head], bx_count, by_count, [&](int nb) {
-          const auto it = std::lower_bound(sorted.begin(), sorted.end(), nb);
-          if (it == sorted.end() || *it != nb || seen[it - sorted.begin()]) return;
-          seen[it - sorted.begin()] = 1;
-          component.push_back(nb);
-        });
-      if (component.size() > best.size()) best.swap(component);
-    }
+    components.forEach(sorted, frame_.blocksX(), frame_.blocksY(), [&](const std::vector<int>& component) {
+      if (component.size() > best.size()) best = component;
+    });
     return best;
   };
   // Alternating assignment from a first split; the parts' summed chi^2 when both fit, else none.

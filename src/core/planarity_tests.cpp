@@ -160,22 +160,8 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
   // on its own; curved patches are dropped, tiny ones too (they cannot be tested).
   constexpr size_t kMinComponentBlocks = 4;
   const int bx_count = frame_.normals.blocksX(), by_count = frame_.normals.blocksY();
-  member_mark_.resize(static_cast<size_t>(bx_count) * by_count, 0);
-  visit_mark_.resize(member_mark_.size(), 0);
-  ++generation_;
-  for (int b : blocks) member_mark_[b] = generation_;
-  std::vector<int> kept, component;
-  for (int seed : blocks)
-  {
-    if (visit_mark_[seed] == generation_) continue;
-    component.assign(1, seed);
-    visit_mark_[seed] = generation_;
-    for (size_t head = 0; head < component.size(); ++head)
-      forEachNeighbour(component[head], bx_count, by_count, [&](int nb) {
-        if (member_mark_[nb] != generation_ || visit_mark_[nb] == generation_) return;
-        visit_mark_[nb] = generation_;
-        component.push_back(nb);
-      });
+  std::vector<int> kept;
+  components_.forEach(blocks, bx_count, by_count, [&](const std::vector<int>& component) {
     int x_min = bx_count, x_max = -1, y_min = by_count, y_max = -1;
     for (int b : component)
     {
@@ -186,7 +172,7 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
     if (component.size() >= kMinComponentBlocks && wide_enough && halvesAgree(component, 0, component.size(), max_angle) &&
         (!also || also(component)))
       kept.insert(kept.end(), component.begin(), component.end());
-  }
+  });
   blocks.swap(kept);
   PointMoments moments;
   for (int b : blocks) moments.add(frame_.normals.block(b % bx_count, b / bx_count));

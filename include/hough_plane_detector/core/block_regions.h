@@ -60,6 +60,42 @@ void forEachNeighbour(int b, int bx_count, int by_count, Visit&& visit)
   if (by + 1 < by_count) visit(b + bx_count);
 }
 
+// The 4-connected components of a set of a block grid's blocks. Its marks are kept across
+// calls, so that finding the components costs the set's size, not the grid's.
+class BlockComponents
+{
+public:
+  // Calls visit(component) for each component of `blocks` (distinct blocks of a bx_count x
+  // by_count grid), in the order of their first block in `blocks`; `component` lives only
+  // during the call.
+  template <class Visit>
+  void forEach(const std::vector<int>& blocks, int bx_count, int by_count, Visit&& visit)
+  {
+    member_.resize(static_cast<size_t>(bx_count) * by_count, 0);
+    visited_.resize(member_.size(), 0);
+    ++generation_;
+    for (int b : blocks) member_[b] = generation_;
+    for (int seed : blocks)
+    {
+      if (visited_[seed] == generation_) continue;
+      component_.assign(1, seed);
+      visited_[seed] = generation_;
+      for (size_t head = 0; head < component_.size(); ++head)
+        forEachNeighbour(component_[head], bx_count, by_count, [&](int nb) {
+          if (member_[nb] != generation_ || visited_[nb] == generation_) return;
+          visited_[nb] = generation_;
+          component_.push_back(nb);
+        });
+      visit(static_cast<const std::vector<int>&>(component_));
+    }
+  }
+
+private:
+  std::vector<int> member_, visited_;  // == generation_: in the set, reached
+  std::vector<int> component_;
+  int generation_ = 0;
+};
+
 // Blocks on a region's rim may straddle the fold to a neighbouring surface (a stair's nosing,
 // a shelf board's back edge against the wall); its interior, the blocks whose four neighbours
 // are in it too, cannot. Fits use the interior when it has at least this many blocks.
@@ -132,8 +168,9 @@ private:
   const NormalEstimator& grid_;
   const std::vector<BlockInfo>& info_;
   const DetectorParams& params_;
-  std::vector<int> mark_;
+  std::vector<int> mark_;  // of sweep
   int generation_ = 0;
+  BlockComponents components_;  // of seedComponents
 };
 
 }  // namespace hough_plane_detector

@@ -80,9 +80,7 @@ public:
 private:
   const DetectorParams& params_;
   const FrameData& frame_;
-  mutable std::vector<int> member_mark_;  // scratch of keepFlatComponents
-  mutable std::vector<int> visit_mark_;
-  mutable int generation_ = 0;
+  mutable BlockComponents components_;  // scratch of keepFlatComponents
 };
 
 }  // namespace hough_plane_detector
