@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -47,6 +48,11 @@ PointMoments FramePlaneFitter::collectPlaneBlocks(const Eigen::Vector3d& normal,
   const int k = params_.normal_window / blockSize(params_.normal_window, params_.normal_stride);
   const int bx_count = frame_.normals.blocksX();
   block_mark_.resize(static_cast<size_t>(bx_count) * frame_.normals.blocksY(), 0);
+  if (mark_generation_ == std::numeric_limits<int>::max())  // after 2^31 calls (weeks at 30 Hz): the marks start over
+  {
+    std::fill(block_mark_.begin(), block_mark_.end(), 0);
+    mark_generation_ = 0;
+  }
   ++mark_generation_;
   // The plane in the camera frame, to test block centroids without transforming blocks.
   const Eigen::Vector3d n_cam = frame_.normalInCamera(normal);

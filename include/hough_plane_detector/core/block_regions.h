@@ -5,6 +5,8 @@
 // small near faces and large far walls are judged alike.
 #pragma once
 
+#include <algorithm>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -73,6 +75,12 @@ public:
   {
     member_.resize(static_cast<size_t>(bx_count) * by_count, 0);
     visited_.resize(member_.size(), 0);
+    if (generation_ == std::numeric_limits<int>::max())  // after 2^31 calls (weeks at 30 Hz): the marks start over
+    {
+      std::fill(member_.begin(), member_.end(), 0);
+      std::fill(visited_.begin(), visited_.end(), 0);
+      generation_ = 0;
+    }
     ++generation_;
     for (int b : blocks) member_[b] = generation_;
     for (int seed : blocks)
