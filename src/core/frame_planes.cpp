@@ -182,9 +182,12 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
   // the weaker peaks. Then every flat block left seeds a region of its own plane: faces too
   // small for a window's vote (box sides, far shelves) are still planes of the frame.
   frame_.block_claim.assign(frame_.blocks.size(), 0);
+  split_group_.assign(planes.size(), -1);
+  int split_count = 0;
   std::vector<char> tried(frame_.blocks.size(), 0);
   BlockRegionGrower grower(frame_.normals, frame_.blocks, params_);
   // An accepted region's plane, snapped or not, joins `planes`; a refused one is a candidate only.
+  int split_group = -1;  // the number of the split whose parts are being kept, else -1
   auto keep = [&](PlaneRegion& region, CandidateVerdict verdict, PointMoments& moments, double peak_value) {
     // The plane of the whole face, bowed edges included, as a least-squares fit to it would be.
     // The region keeps the blocks it was tested on: claiming the bowed edges too moved later
@@ -210,6 +213,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     // A snapped plane is measured by the blocks on it, not by the rim blocks whose lean it undid.
     planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks, normal_sigma,
                                  snapped ? snap_blocks : region.blocks));
+    split_group_.push_back(split_group);
   };
   auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
     PlaneRegion region = grower.grow(seed, n_cam, d_cam, frame_.block_claim);
@@ -218,10 +222,11 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     PointMoments moments;
     CandidateVerdict verdict = testRegion(grower, region, moments);
     // A region over two surfaces is kept as the two planes it splits into; the merge below
-    // does not join them again, as their union mixes surfaces.
+    // leaves that pair apart (split_group_).
     std::vector<int> first, second;
     if (verdict == CandidateVerdict::kAccepted && splitMixedRegion(grower, region, first, second))
     {
+      split_group = split_count++;
       for (std::vector<int>* part : {&first, &second})
       {
         PlaneRegion piece;
@@ -232,6 +237,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
         const CandidateVerdict piece_verdict = testRegion(grower, piece, piece_moments);
         keep(piece, piece_verdict, piece_moments, peak_value);
       }
+      split_group = -1;
       return;
     }
     keep(region, verdict, moments, peak_value);
@@ -320,14 +326,16 @@ void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<
   plane.offset_sigma = std::sqrt(1.0 / information + kCentroidFloor);
 }
 
-void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const
+void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes)
 {
   // Two touching regions whose normals the map would keep apart are one plane when their union
-  // passes the region tests and does not mix surfaces: its blocks, and each part's, lie on the
-  // union's plane within their noise (the bar splitMixedRegion parts regions by). A box face
-  // bowed or warped by a few degrees, grown as two regions, is otherwise reported twice.
+  // passes the region tests and each part lies on the union's plane within its noise: a box
+  // face bowed or warped by a few degrees, grown as two regions, is otherwise reported twice.
   // Folds of more than two merge_angle stay apart, as halvesAgree keeps them; a plane with a
-  // known normal (snapped) measured only its offset and is left as it is.
+  // known normal (snapped) measured only its offset and is left as it is. The bar (mean chi^2
+  // 4 per part) tolerates warp, which the split's noise bound does not: the two parts of a
+  // split were judged two surfaces and stay apart (a real floor's two regions fail the bound
+  // and are joined; kinect-real, CHANGELOG).
   const int bx_count = frame_.blocksX(), by_count = frame_.blocksY();
   std::vector<int> owner(frame_.blocks.size());
   for (bool merged = true; merged;)
@@ -354,6 +362,7 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
       const FramePlane& other = planes[pair.second];
       if (kept.parallel || other.parallel || unsignedAngle(kept.normal, other.normal) > 2.0 * params_.merge_angle)
         continue;
+      if (split_group_[pair.first] >= 0 && split_group_[pair.first] == split_group_[pair.second]) continue;
       PlaneRegion region;
       region.blocks = kept.blocks;
       region.blocks.insert(region.blocks.end(), other.blocks.begin(), other.blocks.end());
@@ -363,15 +372,15 @@ void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std
       PointMoments moments;
       if (testRegion(grower, region, moments) != CandidateVerdict::kAccepted) continue;
       const double normal_sigma = tests_.normalUncertainty(region.blocks);
-      if (!normalDetermined(normal_sigma)) continue;
-      auto mixes = [&](const std::vector<int>& blocks) {
-        return tests_.centroidChi2(region.normal, region.d, blocks) > noiseBoundOfMeanChi2(blocks.size());
-      };
-      if (mixes(region.blocks) || mixes(kept.blocks) || mixes(other.blocks)) continue;
+      if (!normalDetermined(normal_sigma) ||
+          tests_.centroidChi2(region.normal, region.d, kept.blocks) > kMaxMeanCentroidChi2 ||
+          tests_.centroidChi2(region.normal, region.d, other.blocks) > kMaxMeanCentroidChi2)
+        continue;
       const Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
       kept = regionPlane(normal, frame_.dInWorld(normal, region.d), std::max(kept.value, other.value), moments.count,
                          false, region.blocks, normal_sigma, region.blocks);
       planes.erase(planes.begin() + pair.second);
+      split_group_.erase(split_group_.begin() + pair.second);
       merged = true;
       break;  // indices moved: list the touching pairs again
     }

@@ -120,9 +120,9 @@ private:
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
                          const std::vector<int>& blocks, double normal_sigma,
                          const std::vector<int>& measured_by) const;
-  // Joins touching regions of this frame that the region tests accept as one plane whose blocks
-  // do not mix surfaces (so not the two parts of a split region).
-  void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes) const;
+  // Joins touching regions of this frame that the region tests accept as one plane, but not the
+  // two parts of a split region (split_group_).
+  void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes);
   // True when the normal's standard error (normalUncertainty of the blocks) is at most
   // merge_angle / 2: within merge_angle at two sigmas.
   bool normalDetermined(double normal_sigma) const;
@@ -139,6 +139,8 @@ private:
   const PlanarityTests& tests_;
   std::vector<int> block_mark_;  // scratch of collectPlaneBlocks
   int mark_generation_ = 0;
+  // Per plane of growRegions' `planes`: the number of the split region it is a part of, or -1.
+  std::vector<int> split_group_;
 };
 
 }  // namespace hough_plane_detector
