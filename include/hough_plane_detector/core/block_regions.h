@@ -69,7 +69,7 @@ class BlockComponents
 public:
   // Calls visit(component) for each component of `blocks` (distinct blocks of a bx_count x
   // by_count grid), in the order of their first block in `blocks`; `component` lives only
-  // during the call.
+  // during the call, and `visit` must not call forEach of the same object.
   template <class Visit>
   void forEach(const std::vector<int>& blocks, int bx_count, int by_count, Visit&& visit)
   {
