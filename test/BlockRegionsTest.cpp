@@ -156,3 +156,18 @@ TEST(BlockComponents, SplitsASetIntoItsFourConnectedPiecesInTheOrderOfTheirFirst
   components.forEach({5, 15}, bx, by, [&](const std::vector<int>& component) { found.push_back(component); });
   EXPECT_EQ(found.size(), 2u);
 }
+
+TEST(BlockMarks, EmptiesOnClearAndTakesEachBlockOnce)
+{
+  BlockMarks marks;
+  marks.clear(6);
+  EXPECT_FALSE(marks.contains(2));
+  EXPECT_TRUE(marks.insertNew(2));
+  EXPECT_FALSE(marks.insertNew(2));
+  marks.insert(4);
+  EXPECT_TRUE(marks.contains(2));
+  EXPECT_TRUE(marks.contains(4));
+  EXPECT_FALSE(marks.contains(3));
+  marks.clear(10);  // a larger grid: old and new blocks alike start out
+  for (int b = 0; b < 10; ++b) EXPECT_FALSE(marks.contains(b)) << b;
+}

@@ -90,7 +90,7 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
 
 BlockRegionGrower::BlockRegionGrower(const NormalEstimator& grid, const std::vector<BlockInfo>& info,
                                      const DetectorParams& params)
-  : grid_(grid), info_(info), params_(params), mark_(info.size(), 0)
+  : grid_(grid), info_(info), params_(params)
 {
 }
 
@@ -113,13 +113,12 @@ size_t BlockRegionGrower::sweep(std::vector<int>& blocks, const std::vector<char
                                 double d, double warp, bool oriented_only)
 {
   const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
-  ++generation_;
-  for (int b : blocks) mark_[b] = generation_;
+  reached_.clear(info_.size());
+  for (int b : blocks) reached_.insert(b);
   const size_t before = blocks.size();
   for (size_t head = 0; head < blocks.size(); ++head)
     forEachNeighbour(blocks[head], bx_count, by_count, [&](int nb) {
-      if (mark_[nb] == generation_ || taken[nb]) return;
-      mark_[nb] = generation_;
+      if (taken[nb] || !reached_.insertNew(nb)) return;
       if (accepts(nb, normal, d, warp, oriented_only)) blocks.push_back(nb);
     });
   return blocks.size() - before;

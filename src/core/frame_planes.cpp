@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <set>
 #include <utility>
 
@@ -47,13 +46,7 @@ PointMoments FramePlaneFitter::collectPlaneBlocks(const Eigen::Vector3d& normal,
   // Blocks covered by the windows, each once, whose points lie on the plane.
   const int k = params_.normal_window / blockSize(params_.normal_window, params_.normal_stride);
   const int bx_count = frame_.normals.blocksX();
-  block_mark_.resize(static_cast<size_t>(bx_count) * frame_.normals.blocksY(), 0);
-  if (mark_generation_ == std::numeric_limits<int>::max())  // after 2^31 calls (weeks at 30 Hz): the marks start over
-  {
-    std::fill(block_mark_.begin(), block_mark_.end(), 0);
-    mark_generation_ = 0;
-  }
-  ++mark_generation_;
+  collected_.clear(static_cast<size_t>(bx_count) * frame_.normals.blocksY());
   // The plane in the camera frame, to test block centroids without transforming blocks.
   const Eigen::Vector3d n_cam = frame_.normalInCamera(normal);
   const double d_cam = frame_.dInCamera(normal, d);
@@ -64,8 +57,7 @@ PointMoments FramePlaneFitter::collectPlaneBlocks(const Eigen::Vector3d& normal,
       for (int bx = frame_.samples[s].window_x; bx < frame_.samples[s].window_x + k; ++bx)
       {
         const int b = by * bx_count + bx;
-        if (block_mark_[b] == mark_generation_) continue;
-        block_mark_[b] = mark_generation_;
+        if (!collected_.insertNew(b)) continue;
         const BlockInfo& info = frame_.blocks[b];
         if (!info.valid || (!frame_.block_claim.empty() && frame_.block_claim[b])) continue;
         const double residual = std::abs(n_cam.dot(info.centroid) + d_cam);

@@ -62,6 +62,38 @@ void forEachNeighbour(int b, int bx_count, int by_count, Visit&& visit)
   if (by + 1 < by_count) visit(b + bx_count);
 }
 
+// A set of a block grid's blocks that empties in constant time: each block keeps the number of
+// the set it was last put in. Before that number would overflow (after 2^31 sets, weeks at
+// 30 Hz for a detector's long-lived scratch) the marks are cleared and it starts over.
+class BlockMarks
+{
+public:
+  // Empties the set, for a grid of `size` blocks.
+  void clear(size_t size)
+  {
+    marks_.resize(size, 0);
+    if (generation_ == std::numeric_limits<int>::max())
+    {
+      std::fill(marks_.begin(), marks_.end(), 0);
+      generation_ = 0;
+    }
+    ++generation_;
+  }
+  bool contains(int b) const { return marks_[b] == generation_; }
+  void insert(int b) { marks_[b] = generation_; }
+  // Puts b in; false when it was in already.
+  bool insertNew(int b)
+  {
+    if (marks_[b] == generation_) return false;
+    marks_[b] = generation_;
+    return true;
+  }
+
+private:
+  std::vector<int> marks_;
+  int generation_ = 0;
+};
+
 // The 4-connected components of a set of a block grid's blocks. Its marks are kept across
 // calls, so that finding the components costs the set's size, not the grid's.
 class BlockComponents
@@ -73,35 +105,25 @@ public:
   template <class Visit>
   void forEach(const std::vector<int>& blocks, int bx_count, int by_count, Visit&& visit)
   {
-    member_.resize(static_cast<size_t>(bx_count) * by_count, 0);
-    visited_.resize(member_.size(), 0);
-    if (generation_ == std::numeric_limits<int>::max())  // after 2^31 calls (weeks at 30 Hz): the marks start over
-    {
-      std::fill(member_.begin(), member_.end(), 0);
-      std::fill(visited_.begin(), visited_.end(), 0);
-      generation_ = 0;
-    }
-    ++generation_;
-    for (int b : blocks) member_[b] = generation_;
+    const size_t size = static_cast<size_t>(bx_count) * by_count;
+    members_.clear(size);
+    reached_.clear(size);
+    for (int b : blocks) members_.insert(b);
     for (int seed : blocks)
     {
-      if (visited_[seed] == generation_) continue;
+      if (!reached_.insertNew(seed)) continue;
       component_.assign(1, seed);
-      visited_[seed] = generation_;
       for (size_t head = 0; head < component_.size(); ++head)
         forEachNeighbour(component_[head], bx_count, by_count, [&](int nb) {
-          if (member_[nb] != generation_ || visited_[nb] == generation_) return;
-          visited_[nb] = generation_;
-          component_.push_back(nb);
+          if (members_.contains(nb) && reached_.insertNew(nb)) component_.push_back(nb);
         });
       visit(static_cast<const std::vector<int>&>(component_));
     }
   }
 
 private:
-  std::vector<int> member_, visited_;  // == generation_: in the set, reached
+  BlockMarks members_, reached_;
   std::vector<int> component_;
-  int generation_ = 0;
 };
 
 // Blocks on a region's rim may straddle the fold to a neighbouring surface (a stair's nosing,
@@ -176,8 +198,7 @@ private:
   const NormalEstimator& grid_;
   const std::vector<BlockInfo>& info_;
   const DetectorParams& params_;
-  std::vector<int> mark_;  // of sweep
-  int generation_ = 0;
+  BlockMarks reached_;           // of sweep
   BlockComponents components_;  // of seedComponents
 };
 

@@ -137,8 +137,7 @@ private:
   const HoughParameterization& param_;
   FrameData& frame_;
   const PlanarityTests& tests_;
-  std::vector<int> block_mark_;  // scratch of collectPlaneBlocks
-  int mark_generation_ = 0;
+  BlockMarks collected_;  // scratch of collectPlaneBlocks
   // Per plane of growRegions' `planes`: the number of the split region it is a part of, or -1.
   std::vector<int> split_group_;
 };
