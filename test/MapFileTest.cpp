@@ -125,7 +125,7 @@ TEST(MapFile, RefusesBrokenOrForeignFilesAndKeepsTheCurrentMap)
 
 // Forgetting by evidence: each plane's belief (log-odds, confirmations, contradictions) is part
 // of the map (format version 2), so a restored map goes on exactly; a version-1 file (no
-// beliefs) still loads, its planes unconfirmed.
+// beliefs) still loads, its planes unconfirmed, and a version-2 file (no snapped tilts) too.
 TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
 {
   DetectorParams evidence;
@@ -152,22 +152,35 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
     }
   }
 
-  // Version 1: the same bytes without the belief section, version 1, checksum (64-bit FNV-1a) anew.
+  // Versions 1 and 2: the same bytes without the snapped tilts (version 3), then without the
+  // belief section, each with its version number and its checksum (64-bit FNV-1a) anew.
   DetectorParams thinning_params;
   thinning_params.forgetting = kForgetByThinning;  // a map without beliefs, as version 1 wrote
   PlaneDetector thinning{thinning_params};
   warmUp(thinning, 4);
   std::string bytes = thinning.serializeMap();
-  bytes.resize(bytes.size() - sizeof(uint64_t) - sizeof(uint32_t));  // checksum, then a belief count of 0
-  const uint32_t one = 1;
-  std::memcpy(&bytes[8], &one, sizeof(one));
-  uint64_t hash = 1469598103934665603ull;
-  for (char c : bytes)
-  {
-    hash ^= static_cast<unsigned char>(c);
-    hash *= 1099511628211ull;
-  }
-  bytes.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
+  bytes.resize(bytes.size() - sizeof(uint64_t));  // the checksum
+  // The snapped tilts close the file: a count, then that many records.
+  constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 4 + 8 + 4;
+  ASSERT_GT(thinning.map().snapTiltRecords(), 0u) << "the office's later frames snap to its known planes";
+  const size_t tilt_section = sizeof(uint32_t) + thinning.map().snapTiltRecords() * kTiltBytes;
+  auto withVersion = [](std::string body, uint32_t version) {
+    std::memcpy(&body[8], &version, sizeof(version));
+    uint64_t hash = 1469598103934665603ull;
+    for (char c : body)
+    {
+      hash ^= static_cast<unsigned char>(c);
+      hash *= 1099511628211ull;
+    }
+    body.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
+    return body;
+  };
+  bytes.resize(bytes.size() - tilt_section);
+  PlaneDetector version_two_reader(evidence);
+  ASSERT_TRUE(version_two_reader.deserializeMap(withVersion(bytes, 2), &error)) << error;
+  expectSameMap(thinning, version_two_reader);
+  bytes.resize(bytes.size() - sizeof(uint32_t));  // a belief count of 0
+  bytes = withVersion(bytes, 1);
   PlaneDetector old_reader(evidence);
   ASSERT_TRUE(old_reader.deserializeMap(bytes, &error)) << error;
   expectSameMap(thinning, old_reader);

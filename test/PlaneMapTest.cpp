@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "hough_plane_detector/core/plane_geometry.h"
 #include "hough_plane_detector/core/plane_map.h"
 
 using namespace hough_plane_detector;
@@ -30,10 +31,11 @@ struct Map
     p.first_sight_points = first_sight_points < 0.0 ? support : first_sight_points;
     return p;
   }
-  void frame(const std::vector<FramePlane>& planes, double stamp)
+  void frame(const std::vector<FramePlane>& planes, double stamp,
+             const Eigen::Vector3d& camera_position = Eigen::Vector3d::Zero())
   {
     map.beginFrame();
-    map.accumulate(planes, Eigen::Vector3d::Zero(), stamp);
+    map.accumulate(planes, camera_position, stamp);
   }
 };
 const Eigen::Vector3d kFloor = Eigen::Vector3d::UnitZ();
@@ -374,6 +376,71 @@ TEST(PlaneMap, AOneFramePlaneMeasuredAgainNearbyByABetterMeasurementIsReplaced)
     const bool better = later_support >= 16000;
     EXPECT_EQ(matching(m.map.planes(), kFloor).size(), better ? 0u : 1u) << "later support " << later_support;
     EXPECT_EQ(matching(m.map.planes(), tilted).size(), better ? 1u : 0u) << "later support " << later_support;
+  }
+}
+
+// A box front 40 cm before a wall, snapped each frame to the wall's normal (x), while its own
+// blocks fit a normal 0.035 rad off it: each frame's tilt has chi^2 4, under the snap's bar
+// (9.21), but four viewpoints refute the wall's normal (p = 0.001) and the plane moves to its
+// own normal through its centroids, keeping its id. A still camera repeats its error and
+// refutes nothing; tilts that scatter either side of the normal refute nothing either. The
+// pooled tilts are part of the map file: a restored map moves the plane in the same frame.
+TEST(PlaneMap, SnappedMeasurementsWhoseOwnNormalsAgreeElsewhereMoveThePlaneThere)
+{
+  const Eigen::Vector3d wall = Eigen::Vector3d::UnitX();
+  const double tilt = 0.035;
+  const double information = 4.0 / (tilt * tilt);  // per frame, about both axes across the normal
+  auto front = [&](const Map& m, double signed_tilt) {
+    FramePlane p = m.plane(wall, -2.6, 9000);
+    p.parallel = true;
+    p.centroid = Eigen::Vector3d(2.6, 0.5, 1.0);
+    p.own_normal = Eigen::AngleAxisd(signed_tilt, Eigen::Vector3d::UnitZ()) * wall;
+    p.own_normal_information = information * (Eigen::Matrix3d::Identity() - wall * wall.transpose());
+    return p;
+  };
+  const Eigen::Vector3d own = Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitZ()) * wall;
+  auto camera = [](int f) { return Eigen::Vector3d(0.0, 0.1 * f, 1.2); };  // 10 cm per frame, 2.6 m away
+  auto frontPlane = [&](const Map& m) -> const DetectedPlane* {
+    for (const DetectedPlane& p : m.map.planes())
+      if (std::abs(p.d + 2.6 * p.normal.x()) < 0.05 && std::abs(p.normal.x()) > 0.99) return &p;
+    return nullptr;
+  };
+
+  Map moving;
+  Map restored;
+  for (int f = 0; f < 4; ++f)
+  {
+    moving.frame({moving.plane(wall, -3.0, 40000), front(moving, tilt)}, f, camera(f));
+    const DetectedPlane* plane = frontPlane(moving);
+    ASSERT_NE(plane, nullptr) << "frame " << f;
+    if (f == 2)
+    {
+      std::string error;
+      ASSERT_TRUE(restored.map.deserialize(moving.map.serialize(), &error)) << error;
+    }
+    if (f < 3) EXPECT_GT(std::abs(plane->normal.dot(wall)), std::cos(1e-3)) << "frame " << f << ": refuted too early";
+  }
+  const DetectedPlane* moved = frontPlane(moving);
+  EXPECT_LT(unsignedAngle(moved->normal, own), 0.005) << "four viewpoints refute the wall's normal";
+  EXPECT_NEAR(moved->normal.dot(Eigen::Vector3d(2.6, 0.5, 1.0)) + moved->d, 0.0, 0.01) << "through its centroids";
+  ASSERT_EQ(moving.map.planes().size(), 2u);
+  for (const DetectedPlane& p : moving.map.planes())
+    if (&p != moved) EXPECT_GT(std::abs(p.normal.dot(wall)), std::cos(1e-3)) << "the wall keeps its normal";
+  restored.frame({restored.plane(wall, -3.0, 40000), front(restored, tilt)}, 3, camera(3));
+  EXPECT_EQ(restored.map.serialize(), moving.map.serialize());
+
+  Map still;
+  Map scattered;
+  for (int f = 0; f < 8; ++f)
+  {
+    still.frame({still.plane(wall, -3.0, 40000), front(still, tilt)}, f, camera(0));
+    scattered.frame({scattered.plane(wall, -3.0, 40000), front(scattered, f % 2 ? tilt : -tilt)}, f, camera(f));
+  }
+  for (const Map* m : {&still, &scattered})
+  {
+    const DetectedPlane* plane = frontPlane(*m);
+    ASSERT_NE(plane, nullptr);
+    EXPECT_GT(std::abs(plane->normal.dot(wall)), std::cos(1e-3)) << (m == &still ? "still camera" : "scattered tilts");
   }
 }
 

@@ -93,8 +93,9 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
       verdict = CandidateVerdict::kCentroidsOffPlane;
     else if (verdict == CandidateVerdict::kAccepted && !tests_.halvesAgree(blocks, 0, blocks.size(), params_.merge_angle))
       verdict = CandidateVerdict::kHalvesDisagree;
-    const bool snapped =
-        verdict == CandidateVerdict::kAccepted && snapToKnownDirection(normal, d, blocks, map_planes, planes);
+    std::vector<int> snap_blocks;
+    const bool snapped = verdict == CandidateVerdict::kAccepted &&
+                         snapToKnownDirection(normal, d, blocks, map_planes, planes, &snap_blocks);
     if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(tests_.normalUncertainty(blocks)))
       verdict = CandidateVerdict::kNormalUndetermined;
     candidates.push_back({normal, d, peak.value, moments.count, verdict});
@@ -115,6 +116,7 @@ void FramePlaneFitter::fitWindows(const std::vector<HoughPeak>& peaks, const std
     refined.support = moments.count;
     refined.parallel = snapped;
     refined.first_sight_points = first_sight_points;
+    if (snapped) recordOwnNormal(refined, snap_blocks);
     planes.push_back(refined);
   }
 }
@@ -205,6 +207,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     // A snapped plane is measured by the blocks on it, not by the rim blocks whose lean it undid.
     planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks, normal_sigma,
                                  snapped ? snap_blocks : region.blocks));
+    if (snapped) recordOwnNormal(planes.back(), snap_blocks);
     split_group_.push_back(split_group);
   };
   auto consider = [&](const std::vector<int>& seed, const Eigen::Vector3d& n_cam, double d_cam, double peak_value) {
@@ -316,6 +319,16 @@ void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<
   if (!(points.count > 0.0)) return;
   plane.centroid = frame_.camera_to_world * points.mean();
   plane.offset_sigma = std::sqrt(1.0 / information + kCentroidFloor);
+}
+
+void FramePlaneFitter::recordOwnNormal(FramePlane& plane, const std::vector<int>& measured_by) const
+{
+  PlanarityTests::OwnNormal own;
+  if (!tests_.ownNormal(measured_by, own)) return;
+  const Eigen::Matrix3d rotation = frame_.camera_to_world.linear();
+  plane.own_normal = rotation * own.normal;
+  if (plane.own_normal.dot(plane.normal) < 0.0) plane.own_normal = -plane.own_normal;
+  plane.own_normal_information = rotation * own.information * rotation.transpose();
 }
 
 void FramePlaneFitter::mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes)

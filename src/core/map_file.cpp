@@ -15,7 +15,8 @@ namespace hough_plane_detector
 namespace
 {
 constexpr char kMagic[8] = {'H', 'P', 'D', 'M', 'A', 'P', '\n', '\0'};
-constexpr uint32_t kVersion = 2;        // 2: plane beliefs (forgetting by evidence) after the extents
+// 2: plane beliefs (forgetting by evidence) after the extents; 3: the snapped tilts after them.
+constexpr uint32_t kVersion = 3;
 constexpr uint32_t kOldestReadVersion = 1;  // 1: no beliefs; its planes load unconfirmed
 
 uint64_t fnv1a(const char* data, size_t size)
@@ -139,6 +140,22 @@ std::string PlaneMap::serialize() const
     w.put(belief.confirmations);
     w.put(belief.contradictions);
   }
+  std::vector<int> tilt_ids;
+  for (const auto& t : snap_tilts_) tilt_ids.push_back(t.first);
+  std::sort(tilt_ids.begin(), tilt_ids.end());
+  w.put(static_cast<uint32_t>(tilt_ids.size()));
+  for (int id : tilt_ids)
+  {
+    const SnapTilts& tilts = snap_tilts_.at(id);
+    w.put(static_cast<int32_t>(id));
+    for (const Eigen::Matrix3d* m : {&tilts.information, &tilts.viewpoint_information})
+      for (int i = 0; i < 9; ++i) w.put((*m)(i));
+    for (const Eigen::Vector3d* v : {&tilts.weighted_tilt, &tilts.viewpoint_weighted_tilt, &tilts.viewpoint, &tilts.centroid_sum})
+      for (int i = 0; i < 3; ++i) w.put((*v)(i));
+    w.put(static_cast<int32_t>(tilts.viewpoint_frames));
+    w.put(tilts.last_frame);
+    w.put(static_cast<int32_t>(tilts.measurements));
+  }
   return withChecksum(w.bytes);
 }
 
@@ -226,6 +243,29 @@ std::string readBeliefs(Reader& r, std::unordered_map<int, PlaneBelief>& beliefs
   }
   return "";
 }
+std::string readSnapTilts(Reader& r, std::unordered_map<int, SnapTilts>& snap_tilts)
+{
+  uint32_t count;
+  constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 4 + 8 + 4;
+  if (!r.get(count) || count > r.remaining() / kTiltBytes) return "map snapped tilts are truncated";
+  for (uint32_t n = 0; n < count; ++n)
+  {
+    int32_t id, viewpoint_frames, measurements;
+    SnapTilts tilts;
+    bool ok = r.get(id);
+    for (Eigen::Matrix3d* m : {&tilts.information, &tilts.viewpoint_information})
+      for (int i = 0; i < 9; ++i) ok = ok && r.get((*m)(i));
+    for (Eigen::Vector3d* v : {&tilts.weighted_tilt, &tilts.viewpoint_weighted_tilt, &tilts.viewpoint, &tilts.centroid_sum})
+      for (int i = 0; i < 3; ++i) ok = ok && r.get((*v)(i));
+    ok = ok && r.get(viewpoint_frames) && r.get(tilts.last_frame) && r.get(measurements);
+    if (!ok) return "map snapped tilts are truncated";
+    if (viewpoint_frames < 0 || measurements < 0) return "map snapped tilts have a negative count";
+    tilts.viewpoint_frames = viewpoint_frames;
+    tilts.measurements = measurements;
+    snap_tilts[id] = tilts;
+  }
+  return "";
+}
 }  // namespace
 
 bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
@@ -271,10 +311,12 @@ bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
   std::vector<std::pair<int32_t, std::vector<float>>> chunks;
   std::unordered_map<int, PlaneExtent> extents;
   std::unordered_map<int, PlaneBelief> beliefs;
+  std::unordered_map<int, SnapTilts> snap_tilts;
   std::string problem = readPlanes(r, planes);
   if (problem.empty()) problem = readChunks(r, global_.topLevelCount(), chunks);
   if (problem.empty()) problem = readExtents(r, extents);
   if (problem.empty() && version >= 2) problem = readBeliefs(r, beliefs);
+  if (problem.empty() && version >= 3) problem = readSnapTilts(r, snap_tilts);
   if (!problem.empty()) return fail(problem);
   if (r.position() != bytes.size() - sizeof(uint64_t)) return fail("map has trailing bytes");
 
@@ -291,6 +333,7 @@ bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
   }
   extents_.swap(extents);
   beliefs_.swap(beliefs);
+  snap_tilts_.swap(snap_tilts);
   next_id_ = next_id;
   frame_count_ = frame_count;
   return true;

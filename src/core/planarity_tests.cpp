@@ -205,21 +205,31 @@ PlanarityTests::NormalExplanation PlanarityTests::explainNormal(const Eigen::Vec
   return verdict;
 }
 
+PointMoments PlanarityTests::noiseWeightedCentroids(const std::vector<int>& blocks) const
+{
+  const int bx_count = frame_.normals.blocksX();
+  PointMoments sum;
+  for (int b : blocks)
+  {
+    PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
+    const double weight = 1.0 / (frame_.blocks[b].centroid_variance + kCentroidFloor);
+    m.scale(weight / m.count);
+    sum.add(m);
+  }
+  return sum;
+}
+
 double PlanarityTests::snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
 {
   // Centroids weighted by their inverse variance: the smallest eigenvalue of their scatter
   // times the total weight is the chi^2 of the best free plane; the fixed normal's best plane
   // has the weighted variance of the offsets along it.
-  const int bx_count = frame_.normals.blocksX();
-  PointMoments sum;
+  const PointMoments sum = noiseWeightedCentroids(blocks);
   double weight_sum = 0.0, offset_sum = 0.0, offset_squares = 0.0;
   for (int b : blocks)
   {
     const BlockInfo& info = frame_.blocks[b];
     const double weight = 1.0 / (info.centroid_variance + kCentroidFloor);
-    PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
-    m.scale(weight / m.count);
-    sum.add(m);
     const double offset = n_cam.dot(info.centroid);
     weight_sum += weight;
     offset_sum += weight * offset;
@@ -230,6 +240,22 @@ double PlanarityTests::snapChi2Increase(const Eigen::Vector3d& n_cam, const std:
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(sum.covariance());
   return fixed_chi2 - std::max(0.0, solver.eigenvalues()(0)) * sum.count;
+}
+
+bool PlanarityTests::ownNormal(const std::vector<int>& blocks, OwnNormal& own) const
+{
+  std::vector<int> interior = interiorBlocks(blocks, frame_.normals.blocksX(), frame_.normals.blocksY());
+  const std::vector<int>& fitted = interior.size() >= kMinInteriorBlocks ? interior : blocks;
+  if (fitted.size() < 3) return false;
+  const PointMoments sum = noiseWeightedCentroids(fitted);
+  // The scatter about the weighted mean: tilting the plane by t moves a centroid x off it by
+  // t . (x - mean), so the chi^2 rises by t' scatter t.
+  const Eigen::Matrix3d scatter = sum.covariance() * sum.count;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(scatter);
+  own.normal = solver.eigenvectors().col(0).normalized();
+  own.information = scatter;
+  return true;
 }
 
 double PlanarityTests::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 #include "hough_plane_detector/core/block_regions.h"
 #include "hough_plane_detector/core/plane_geometry.h"
@@ -13,6 +14,10 @@ namespace
 {
 // Beyond the merge tolerances, where a noisy re-measurement of a plane still falls.
 constexpr double kNearTolerances = 3.0;
+// Pooled snapped tilts that refute a map plane's normal: chi^2 with 2 dof, p = 0.001.
+constexpr double kRefutedSnapChi2 = 13.82;
+// Camera displacement over the distance to a face below which two frames share a viewpoint.
+constexpr double kSameViewpoint = 8.0 / 580.0;
 }  // namespace
 
 PlaneMap::PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
@@ -30,6 +35,7 @@ void PlaneMap::clear()
   chunks_evicted_total_ = 0;
   extents_.clear();
   beliefs_.clear();
+  snap_tilts_.clear();
   frame_count_ = 0;
   global_.clear();
   planes_.clear();
@@ -81,7 +87,117 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
                         [&](const HoughPeak& a, const HoughPeak& b) { return measuredApart(a, b, frame_planes); });
   matchIds(peaks, camera_position, stamp);
   if (params_.forgetting == kForgetByEvidence) carryBeliefs();
+  reseatRefutedSnaps(frame_planes, camera_position);
   return evicted;
+}
+
+void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, const Eigen::Vector3d& camera_position)
+{
+  // Records of planes that left the map go with them.
+  for (auto it = snap_tilts_.begin(); it != snap_tilts_.end();)
+  {
+    const bool kept = std::any_of(planes_.begin(), planes_.end(), [&](const DetectedPlane& p) { return p.id == it->first; });
+    it = kept ? std::next(it) : snap_tilts_.erase(it);
+  }
+  std::vector<char> updated(planes_.size(), 0);
+  for (const FramePlane& measured : frame_planes)
+  {
+    if (measured.own_normal.isZero()) continue;
+    // The map plane it voted into: the closest within the merge tolerances.
+    int match = -1;
+    double best_cost = 0.0;
+    for (size_t p = 0; p < planes_.size(); ++p)
+    {
+      if (!samePlane(planes_[p], measured)) continue;
+      const double sign = planes_[p].normal.dot(measured.normal) >= 0.0 ? 1.0 : -1.0;
+      const double cost = unsignedAngle(planes_[p].normal, measured.normal) / params_.merge_angle +
+                          std::abs(planes_[p].d - sign * measured.d) / params_.merge_distance;
+      if (match < 0 || cost < best_cost)
+      {
+        match = static_cast<int>(p);
+        best_cost = cost;
+      }
+    }
+    if (match < 0) continue;
+    const Eigen::Vector3d& normal = planes_[match].normal;
+    const Eigen::Vector3d own = normal.dot(measured.own_normal) >= 0.0 ? measured.own_normal : -measured.own_normal;
+    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - normal * normal.transpose();
+    const Eigen::Matrix3d information = across * measured.own_normal_information * across;
+    SnapTilts& tilts = snap_tilts_[planes_[match].id];
+    // A new viewpoint when the camera moved a block's width as seen from the face (8 of a
+    // Kinect's 580 px): the depth errors fixed to pixels then fall elsewhere on it.
+    const bool same_viewpoint = tilts.viewpoint_frames > 0 && (camera_position - tilts.viewpoint).norm() <
+                                                                  kSameViewpoint * (measured.centroid - camera_position).norm();
+    if (!same_viewpoint)
+    {
+      if (tilts.viewpoint_frames > 0)
+      {
+        tilts.information += tilts.viewpoint_information / tilts.viewpoint_frames;
+        tilts.weighted_tilt += tilts.viewpoint_weighted_tilt / tilts.viewpoint_frames;
+      }
+      tilts.viewpoint_information.setZero();
+      tilts.viewpoint_weighted_tilt.setZero();
+      tilts.viewpoint_frames = 0;
+      tilts.viewpoint = camera_position;
+    }
+    if (tilts.last_frame != frame_count_) ++tilts.viewpoint_frames;
+    tilts.last_frame = frame_count_;
+    tilts.viewpoint_information += information;
+    tilts.viewpoint_weighted_tilt += information * (across * own);
+    tilts.centroid_sum += measured.centroid;
+    ++tilts.measurements;
+    updated[match] = 1;
+  }
+  const float cap = static_cast<float>(params_.permanence_cap);
+  for (size_t p = 0; p < planes_.size(); ++p)
+  {
+    if (!updated[p]) continue;
+    DetectedPlane& plane = planes_[p];
+    const SnapTilts& tilts = snap_tilts_[plane.id];
+    const Eigen::Matrix3d pooled = tilts.information + tilts.viewpoint_information / tilts.viewpoint_frames;
+    const Eigen::Vector3d weighted_tilt = tilts.weighted_tilt + tilts.viewpoint_weighted_tilt / tilts.viewpoint_frames;
+    // The pooled tilt lies across the normal; the normal's own direction is made invertible.
+    const Eigen::Matrix3d information = pooled + (pooled.trace() + 1e-12) * plane.normal * plane.normal.transpose();
+    const Eigen::Vector3d tilt = information.ldlt().solve(weighted_tilt);
+    if (weighted_tilt.dot(tilt) <= kRefutedSnapChi2) continue;
+    const Eigen::Vector3d normal = (plane.normal + tilt).normalized();
+    const double d = -normal.dot(tilts.centroid_sum / tilts.measurements);
+    clearOwnPeakCells(p);
+    plane.normal = normal;
+    plane.d = d;
+    plane.hough = param_.toHough(normal, d);
+    const float weight = std::min(static_cast<float>(plane.strength), cap);
+    voting_.addGaussian(global_, plane.hough, weight, cap);
+    Eigen::Vector3d mirrored;
+    if (param_.mirror(plane.hough, mirrored)) voting_.addGaussian(global_, mirrored, weight, cap);
+    snap_tilts_.erase(plane.id);
+  }
+}
+
+void PlaneMap::clearOwnPeakCells(size_t index)
+{
+  // Cells nearer another map plane's peak are that plane's votes, however close the two lie.
+  std::vector<Eigen::Vector3d> others;
+  for (size_t p = 0; p < planes_.size(); ++p)
+  {
+    if (p == index) continue;
+    others.push_back(param_.toCell(planes_[p].hough));
+    Eigen::Vector3d mirrored;
+    if (param_.mirror(planes_[p].hough, mirrored)) others.push_back(param_.toCell(mirrored));
+  }
+  std::vector<Eigen::Vector3d> own{param_.toCell(planes_[index].hough)};
+  Eigen::Vector3d mirrored;
+  if (param_.mirror(planes_[index].hough, mirrored)) own.push_back(param_.toCell(mirrored));
+  forPeakCells(planes_[index].hough, [&](int x, int y, int z) {
+    const float v = global_.value(x, y, z);
+    if (v <= 0.0f) return;
+    const Eigen::Vector3d cell(x, y, z);
+    double nearest_own = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d& c : own) nearest_own = std::min(nearest_own, (cell - c).squaredNorm());
+    for (const Eigen::Vector3d& c : others)
+      if ((cell - c).squaredNorm() < nearest_own) return;
+    global_.add(x, y, z, -v);
+  });
 }
 
 bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const

@@ -65,6 +65,11 @@ struct FramePlane
   // took blocks of another surface or bends, so one frame does not report it (plane_map.cpp).
   bool mixes_surfaces = false;
   std::vector<int> blocks;  // region_growing: the blocks of its region
+  // Snapped: the normal the blocks that measured it fit by themselves (world frame, on the side
+  // of `normal`) and its information (1/rad^2), so that the map can test over frames whether
+  // the known normal explains them (PlaneMap::reseatRefutedSnaps); zero otherwise.
+  Eigen::Vector3d own_normal = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d own_normal_information = Eigen::Matrix3d::Zero();
 };
 
 class FramePlaneFitter
@@ -111,6 +116,8 @@ private:
                         std::vector<int>& second) const;
   // Sets the plane's centroid and offset error from the blocks that measured it.
   void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
+  // A snapped plane's own_normal and its information, from the blocks that measured it.
+  void recordOwnNormal(FramePlane& plane, const std::vector<int>& measured_by) const;
   // FramePlane::fits_its_blocks and mixes_surfaces: how the blocks' centroids, and the interior's
   // own plane, agree with (normal, d) within the sensor's noise.
   void testFitToBlocks(FramePlane& plane, const std::vector<int>& blocks) const;

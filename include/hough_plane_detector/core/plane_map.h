@@ -26,6 +26,23 @@
 namespace hough_plane_detector
 {
 
+// A map plane's snapped measurements so far (world frame): their own normals' information
+// and its product with their tilts off the plane's normal, summed over viewpoints, each
+// viewpoint's frames averaged into one (a still camera repeats its systematic error); and
+// the centroids they measured.
+struct SnapTilts
+{
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d weighted_tilt = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d viewpoint_information = Eigen::Matrix3d::Zero();  // the current viewpoint's frames, summed
+  Eigen::Vector3d viewpoint_weighted_tilt = Eigen::Vector3d::Zero();
+  int viewpoint_frames = 0;
+  int64_t last_frame = -1;
+  Eigen::Vector3d viewpoint = Eigen::Vector3d::Zero();  // camera position of the current viewpoint
+  Eigen::Vector3d centroid_sum = Eigen::Vector3d::Zero();
+  int measurements = 0;
+};
+
 class PlaneMap
 {
 public:
@@ -53,6 +70,8 @@ public:
   const std::vector<DetectedPlane>& planes() const { return planes_; }
   const SparseHoughSpace& space() const { return global_; }
   size_t chunksEvictedTotal() const { return chunks_evicted_total_; }
+  // Map planes with snapped measurements pooled (reseatRefutedSnaps).
+  size_t snapTiltRecords() const { return snap_tilts_.size(); }
   // Where the plane has been seen (nullptr for an unknown id).
   const PlaneExtent* extent(int id) const;
   std::vector<Eigen::Vector3d> hull(const DetectedPlane& plane) const;
@@ -100,6 +119,14 @@ private:
   void carryBeliefs();
   // How fast extents fade per frame: with thinning as the Hough space does, by evidence never.
   float extentFade() const;
+  // A snapped measurement took a known normal its blocks may only nearly fit (a box front 2 deg
+  // off the wall behind it), and the map plane it makes keeps that normal. Each frame's own fit
+  // tilts from it by noise, or by that error every time: the tilts are pooled per map plane, and
+  // a plane they refute together (chi^2, 2 dof, p = 0.001) moves to their own normal through
+  // the centroids they measured, keeping its votes and id.
+  void reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, const Eigen::Vector3d& camera_position);
+  // Zeroes the cells forPeakCells visits around planes_[index] that lie nearer its peak than any other plane's.
+  void clearOwnPeakCells(size_t index);
 
   const DetectorParams& params_;
   const HoughParameterization& param_;
@@ -109,6 +136,7 @@ private:
   std::vector<DetectedPlane> planes_;
   std::unordered_map<int, PlaneExtent> extents_;
   std::unordered_map<int, PlaneBelief> beliefs_;  // forgetting by evidence, by plane id
+  std::unordered_map<int, SnapTilts> snap_tilts_;  // by plane id
   int64_t frame_count_ = 0;          // frames since the map began (extents fade by it)
   size_t chunks_evicted_total_ = 0;  // chunks freed by the max_chunks cap since the map began
   int next_id_ = 0;
