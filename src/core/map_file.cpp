@@ -19,6 +19,16 @@ constexpr char kMagic[8] = {'H', 'P', 'D', 'M', 'A', 'P', '\n', '\0'};
 constexpr uint32_t kVersion = 3;
 constexpr uint32_t kOldestReadVersion = 1;  // 1: no beliefs; its planes load unconfirmed
 
+// A map's keys in order: a map file does not depend on hash order.
+template <class Map>
+std::vector<int> sortedIds(const Map& by_id)
+{
+  std::vector<int> ids;
+  for (const auto& entry : by_id) ids.push_back(entry.first);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
 uint64_t fnv1a(const char* data, size_t size)
 {
   uint64_t hash = 1469598103934665603ull;
@@ -108,10 +118,7 @@ std::string PlaneMap::serialize() const
     w.putBytes(global_.chunkData(index), sizeof(float) * SparseHoughSpace::kChunkCells);
   }
   w.put(static_cast<uint32_t>(extents_.size()));
-  std::vector<int> ids;
-  for (const auto& e : extents_) ids.push_back(e.first);
-  std::sort(ids.begin(), ids.end());
-  for (int id : ids)
+  for (int id : sortedIds(extents_))
   {
     const PlaneExtent& extent = extents_.at(id);
     const auto cells = extent.cells();
@@ -128,9 +135,7 @@ std::string PlaneMap::serialize() const
       w.put(cell.second.seen);
     }
   }
-  std::vector<int> belief_ids;
-  for (const auto& b : beliefs_) belief_ids.push_back(b.first);
-  std::sort(belief_ids.begin(), belief_ids.end());
+  const std::vector<int> belief_ids = sortedIds(beliefs_);
   w.put(static_cast<uint32_t>(belief_ids.size()));
   for (int id : belief_ids)
   {
@@ -140,9 +145,7 @@ std::string PlaneMap::serialize() const
     w.put(belief.confirmations);
     w.put(belief.contradictions);
   }
-  std::vector<int> tilt_ids;
-  for (const auto& t : snap_tilts_) tilt_ids.push_back(t.first);
-  std::sort(tilt_ids.begin(), tilt_ids.end());
+  const std::vector<int> tilt_ids = sortedIds(snap_tilts_);
   w.put(static_cast<uint32_t>(tilt_ids.size()));
   for (int id : tilt_ids)
   {
