@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
@@ -206,6 +207,28 @@ TEST(MapFile, AbsurdCountsAreRefusedBeforeAllocating)
   EXPECT_NE(error.find("plane count does not fit"), std::string::npos) << error;
   // The unchanged body with its checksum still loads.
   EXPECT_TRUE(target.deserializeMap(PlaneDetector::withMapChecksum(body), &error)) << error;
+}
+
+// The pooled tilts of snapped planes decide where a plane moves: a file whose tilts are not
+// finite (NaN would move a plane to a NaN normal) is refused, and the current map stays.
+TEST(MapFile, SnappedTiltsThatAreNotFiniteAreRefused)
+{
+  PlaneDetector source{DetectorParams()};
+  warmUp(source, 4);
+  ASSERT_GT(source.map().snapTiltRecords(), 0u) << "the office's later frames snap to its known planes";
+  std::string body = source.serializeMap();
+  body.resize(body.size() - sizeof(uint64_t));  // without its checksum
+  // The last record's information(0, 0), after its id: the records close the file.
+  constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 4 + 8 + 4;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::memcpy(&body[body.size() - kTiltBytes + 4], &nan, sizeof(nan));
+  PlaneDetector target{DetectorParams()};
+  warmUp(target, 2);
+  const std::string before = target.serializeMap();
+  std::string error;
+  EXPECT_FALSE(target.deserializeMap(PlaneDetector::withMapChecksum(body), &error));
+  EXPECT_NE(error.find("not finite"), std::string::npos) << error;
+  EXPECT_EQ(target.serializeMap(), before);
 }
 
 TEST(MapFile, SavingToAnUnwritablePlaceFailsCleanly)

@@ -408,11 +408,14 @@ TEST(PlaneMap, SnappedMeasurementsWhoseOwnNormalsAgreeElsewhereMoveThePlaneThere
 
   Map moving;
   Map restored;
+  int front_id = -1;
   for (int f = 0; f < 4; ++f)
   {
     moving.frame({moving.plane(wall, -3.0, 40000), front(moving, tilt)}, f, camera(f));
     const DetectedPlane* plane = frontPlane(moving);
     ASSERT_NE(plane, nullptr) << "frame " << f;
+    if (f == 0) front_id = plane->id;
+    EXPECT_EQ(plane->id, front_id) << "frame " << f;
     if (f == 2)
     {
       std::string error;

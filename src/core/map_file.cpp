@@ -246,6 +246,7 @@ std::string readBeliefs(Reader& r, std::unordered_map<int, PlaneBelief>& beliefs
   }
   return "";
 }
+
 std::string readSnapTilts(Reader& r, std::unordered_map<int, SnapTilts>& snap_tilts)
 {
   uint32_t count;
@@ -263,6 +264,9 @@ std::string readSnapTilts(Reader& r, std::unordered_map<int, SnapTilts>& snap_ti
     ok = ok && r.get(viewpoint_frames) && r.get(tilts.last_frame) && r.get(measurements);
     if (!ok) return "map snapped tilts are truncated";
     if (viewpoint_frames < 0 || measurements < 0) return "map snapped tilts have a negative count";
+    if (!tilts.information.allFinite() || !tilts.viewpoint_information.allFinite() || !tilts.weighted_tilt.allFinite() ||
+        !tilts.viewpoint_weighted_tilt.allFinite() || !tilts.viewpoint.allFinite() || !tilts.centroid_sum.allFinite())
+      return "map snapped tilts are not finite";
     tilts.viewpoint_frames = viewpoint_frames;
     tilts.measurements = measurements;
     snap_tilts[id] = tilts;

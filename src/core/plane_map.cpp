@@ -159,7 +159,7 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
     // The pooled tilt lies across the normal; the normal's own direction is made invertible.
     const Eigen::Matrix3d information = pooled + (pooled.trace() + 1e-12) * plane.normal * plane.normal.transpose();
     const Eigen::Vector3d tilt = information.ldlt().solve(weighted_tilt);
-    if (weighted_tilt.dot(tilt) <= kRefutedSnapChi2) continue;
+    if (!(weighted_tilt.dot(tilt) > kRefutedSnapChi2)) continue;  // also when not finite
     const Eigen::Vector3d normal = (plane.normal + tilt).normalized();
     const double d = -normal.dot(tilts.centroid_sum / tilts.measurements);
     clearOwnPeakCells(p);
