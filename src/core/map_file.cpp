@@ -155,9 +155,9 @@ std::string PlaneMap::serialize() const
       for (int i = 0; i < 9; ++i) w.put((*m)(i));
     for (const Eigen::Vector3d* v : {&tilts.weighted_tilt, &tilts.viewpoint_weighted_tilt, &tilts.viewpoint, &tilts.centroid_sum})
       for (int i = 0; i < 3; ++i) w.put((*v)(i));
-    w.put(static_cast<int32_t>(tilts.viewpoint_frames));
+    w.put(tilts.viewpoint_frames);
     w.put(tilts.last_frame);
-    w.put(static_cast<int32_t>(tilts.measurements));
+    w.put(tilts.measurements);
   }
   return withChecksum(w.bytes);
 }
@@ -250,25 +250,23 @@ std::string readBeliefs(Reader& r, std::unordered_map<int, PlaneBelief>& beliefs
 std::string readSnapTilts(Reader& r, std::unordered_map<int, SnapTilts>& snap_tilts)
 {
   uint32_t count;
-  constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 4 + 8 + 4;
+  constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 3 * 8;
   if (!r.get(count) || count > r.remaining() / kTiltBytes) return "map snapped tilts are truncated";
   for (uint32_t n = 0; n < count; ++n)
   {
-    int32_t id, viewpoint_frames, measurements;
+    int32_t id;
     SnapTilts tilts;
     bool ok = r.get(id);
     for (Eigen::Matrix3d* m : {&tilts.information, &tilts.viewpoint_information})
       for (int i = 0; i < 9; ++i) ok = ok && r.get((*m)(i));
     for (Eigen::Vector3d* v : {&tilts.weighted_tilt, &tilts.viewpoint_weighted_tilt, &tilts.viewpoint, &tilts.centroid_sum})
       for (int i = 0; i < 3; ++i) ok = ok && r.get((*v)(i));
-    ok = ok && r.get(viewpoint_frames) && r.get(tilts.last_frame) && r.get(measurements);
+    ok = ok && r.get(tilts.viewpoint_frames) && r.get(tilts.last_frame) && r.get(tilts.measurements);
     if (!ok) return "map snapped tilts are truncated";
-    if (viewpoint_frames < 0 || measurements < 0) return "map snapped tilts have a negative count";
+    if (tilts.viewpoint_frames < 0 || tilts.measurements < 0) return "map snapped tilts have a negative count";
     if (!tilts.information.allFinite() || !tilts.viewpoint_information.allFinite() || !tilts.weighted_tilt.allFinite() ||
         !tilts.viewpoint_weighted_tilt.allFinite() || !tilts.viewpoint.allFinite() || !tilts.centroid_sum.allFinite())
       return "map snapped tilts are not finite";
-    tilts.viewpoint_frames = viewpoint_frames;
-    tilts.measurements = measurements;
     snap_tilts[id] = tilts;
   }
   return "";

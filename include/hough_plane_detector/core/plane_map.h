@@ -36,11 +36,11 @@ struct SnapTilts
   Eigen::Vector3d weighted_tilt = Eigen::Vector3d::Zero();
   Eigen::Matrix3d viewpoint_information = Eigen::Matrix3d::Zero();  // the current viewpoint's frames, summed
   Eigen::Vector3d viewpoint_weighted_tilt = Eigen::Vector3d::Zero();
-  int viewpoint_frames = 0;
+  int64_t viewpoint_frames = 0;  // 64 bits: a still camera's frames count up for as long as it runs
   int64_t last_frame = -1;
   Eigen::Vector3d viewpoint = Eigen::Vector3d::Zero();  // camera position of the current viewpoint
   Eigen::Vector3d centroid_sum = Eigen::Vector3d::Zero();
-  int measurements = 0;
+  int64_t measurements = 0;
 };
 
 class PlaneMap
