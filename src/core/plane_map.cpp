@@ -72,9 +72,7 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   {
     const float weight = voteWeight(plane, frame_planes);
     full_height.push_back(weight >= 2.0f);
-    voting_.addGaussian(global_, plane.hough, weight, cap);
-    Eigen::Vector3d mirrored;
-    if (param_.mirror(plane.hough, mirrored)) voting_.addGaussian(global_, mirrored, weight, cap);
+    addVote(plane.hough, weight, cap);
     seeds.push_back(nearestCell(param_.toCell(plane.hough)));
   }
   for (const DetectedPlane& plane : planes_) seeds.push_back(nearestCell(param_.toCell(plane.hough)));
@@ -109,9 +107,7 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
     for (size_t p = 0; p < planes_.size(); ++p)
     {
       if (!samePlane(planes_[p], measured)) continue;
-      const double sign = planes_[p].normal.dot(measured.normal) >= 0.0 ? 1.0 : -1.0;
-      const double cost = unsignedAngle(planes_[p].normal, measured.normal) / params_.merge_angle +
-                          std::abs(planes_[p].d - sign * measured.d) / params_.merge_distance;
+      const double cost = mergeCost(measured.normal, measured.d, planes_[p].normal, planes_[p].d);
       if (match < 0 || cost < best_cost)
       {
         match = static_cast<int>(p);
@@ -166,12 +162,23 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
     plane.normal = normal;
     plane.d = d;
     plane.hough = param_.toHough(normal, d);
-    const float weight = std::min(static_cast<float>(plane.strength), cap);
-    voting_.addGaussian(global_, plane.hough, weight, cap);
-    Eigen::Vector3d mirrored;
-    if (param_.mirror(plane.hough, mirrored)) voting_.addGaussian(global_, mirrored, weight, cap);
+    addVote(plane.hough, std::min(static_cast<float>(plane.strength), cap), cap);
     snap_tilts_.erase(plane.id);
   }
+}
+
+double PlaneMap::mergeCost(const Eigen::Vector3d& normal_a, double d_a, const Eigen::Vector3d& normal_b,
+                           double d_b) const
+{
+  const double sign = normal_a.dot(normal_b) >= 0.0 ? 1.0 : -1.0;
+  return unsignedAngle(normal_a, normal_b) / params_.merge_angle + std::abs(sign * d_a - d_b) / params_.merge_distance;
+}
+
+void PlaneMap::addVote(const Eigen::Vector3d& hough, float weight, float cap)
+{
+  voting_.addGaussian(global_, hough, weight, cap);
+  Eigen::Vector3d mirrored;
+  if (param_.mirror(hough, mirrored)) voting_.addGaussian(global_, mirrored, weight, cap);
 }
 
 void PlaneMap::clearOwnPeakCells(size_t index)
@@ -205,9 +212,7 @@ bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::
   // Two nearby peaks are two surfaces when one frame measured a plane at each (two box tops a
   // few cm apart), or the map already held them apart; else they are one plane's measurements.
   auto cost = [&](const Eigen::Vector3d& normal, double d, const HoughPeak& peak) {
-    const double sign = normal.dot(peak.normal) >= 0.0 ? 1.0 : -1.0;
-    return unsignedAngle(normal, peak.normal) / params_.merge_angle +
-           std::abs(sign * d - peak.d) / params_.merge_distance;
+    return mergeCost(normal, d, peak.normal, peak.d);
   };
   // Planes of one list, one nearer each peak, that are two surfaces themselves.
   auto apart = [&](const auto& planes, const auto& two_surfaces) {

@@ -125,6 +125,10 @@ private:
   // a plane they refute together (chi^2, 2 dof, p = 0.001) moves to their own normal through
   // the centroids they measured, keeping its votes and id.
   void reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, const Eigen::Vector3d& camera_position);
+  // How far apart two planes are in merge tolerances (angle / merge_angle + offset / merge_distance).
+  double mergeCost(const Eigen::Vector3d& normal_a, double d_a, const Eigen::Vector3d& normal_b, double d_b) const;
+  // One Gaussian vote at `hough`, and at its mirrored copy near the border.
+  void addVote(const Eigen::Vector3d& hough, float weight, float cap);
   // Zeroes the cells forPeakCells visits around planes_[index] that lie nearer its peak than any other plane's.
   void clearOwnPeakCells(size_t index);
 
