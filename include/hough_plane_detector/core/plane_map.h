@@ -106,9 +106,8 @@ private:
   void forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const;
   // True when one of this frame's planes lies on `plane` within the merge tolerances.
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
-  // Two surfaces closer than a peak window share one maximum: when this frame measured them
-  // apart, or the map held them apart and depths confirmed them, the maximum's peak moves to
-  // one of them and each other gets a peak at its own place (this frame's, else the map's).
+  // Adds a peak for each surface beside an extracted peak that climbs to it: one this frame
+  // measured apart from the surface nearest the peak, or a confirmed map plane held apart.
   void addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes, std::vector<HoughPeak>& peaks) const;
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
   bool measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const;
