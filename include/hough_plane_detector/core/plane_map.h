@@ -106,9 +106,6 @@ private:
   void forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const;
   // True when one of this frame's planes lies on `plane` within the merge tolerances.
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
-  // Adds a peak for each surface beside an extracted peak that climbs to it: one this frame
-  // measured apart from the surface nearest the peak, or a confirmed map plane held apart.
-  void addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes, std::vector<HoughPeak>& peaks) const;
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
   bool measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const;
   // True when two planes one frame measured are two surfaces: not similar by eq. 7-8, or their
@@ -132,10 +129,7 @@ private:
   double mergeCost(const Eigen::Vector3d& normal_a, double d_a, const Eigen::Vector3d& normal_b, double d_b) const;
   // One Gaussian vote at `hough`, and at its mirrored copy near the border.
   void addVote(const Eigen::Vector3d& hough, float weight, float cap);
-  // Calls f on the cells forPeakCells visits around planes_[index] that lie nearer its peak
-  // than any other plane's: a neighbour's votes are not its own, however close the two lie.
-  void forOwnPeakCells(size_t index, const std::function<void(int, int, int)>& f) const;
-  // Zeroes the cells forOwnPeakCells visits.
+  // Zeroes the cells forPeakCells visits around planes_[index] that lie nearer its peak than any other plane's.
   void clearOwnPeakCells(size_t index);
 
   const DetectorParams& params_;
