@@ -12,6 +12,9 @@ using namespace hough_plane_detector;
 
 namespace
 {
+// One snapped plane's pooled-tilt record in a version-3 file: id, two 3 x 3 informations, four
+// vectors, then viewpoint_frames, last_frame and measurements (64 bits each).
+constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 3 * 8;
 // A detector that has seen a few frames of the office.
 void warmUp(PlaneDetector& detector, int frames)
 {
@@ -162,7 +165,6 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
   std::string bytes = thinning.serializeMap();
   bytes.resize(bytes.size() - sizeof(uint64_t));  // the checksum
   // The snapped tilts close the file: a count, then that many records.
-  constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 3 * 8;
   ASSERT_GT(thinning.map().snapTiltRecords(), 0u) << "the office's later frames snap to its known planes";
   const size_t tilt_section = sizeof(uint32_t) + thinning.map().snapTiltRecords() * kTiltBytes;
   auto withVersion = [](std::string body, uint32_t version) {
@@ -219,7 +221,6 @@ TEST(MapFile, SnappedTiltsThatAreNotFiniteAreRefused)
   std::string body = source.serializeMap();
   body.resize(body.size() - sizeof(uint64_t));  // without its checksum
   // The last record's information(0, 0), after its id: the records close the file.
-  constexpr size_t kTiltBytes = 4 + 8 * (2 * 9 + 4 * 3) + 3 * 8;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::memcpy(&body[body.size() - kTiltBytes + 4], &nan, sizeof(nan));
   PlaneDetector target{DetectorParams()};

@@ -421,14 +421,22 @@ TEST(PlaneMap, SnappedMeasurementsWhoseOwnNormalsAgreeElsewhereMoveThePlaneThere
       std::string error;
       ASSERT_TRUE(restored.map.deserialize(moving.map.serialize(), &error)) << error;
     }
-    if (f < 3) EXPECT_GT(std::abs(plane->normal.dot(wall)), std::cos(1e-3)) << "frame " << f << ": refuted too early";
+    if (f < 3)
+    {
+      EXPECT_GT(std::abs(plane->normal.dot(wall)), std::cos(1e-3)) << "frame " << f << ": refuted too early";
+    }
   }
   const DetectedPlane* moved = frontPlane(moving);
   EXPECT_LT(unsignedAngle(moved->normal, own), 0.005) << "four viewpoints refute the wall's normal";
   EXPECT_NEAR(moved->normal.dot(Eigen::Vector3d(2.6, 0.5, 1.0)) + moved->d, 0.0, 0.01) << "through its centroids";
   ASSERT_EQ(moving.map.planes().size(), 2u);
   for (const DetectedPlane& p : moving.map.planes())
-    if (&p != moved) EXPECT_GT(std::abs(p.normal.dot(wall)), std::cos(1e-3)) << "the wall keeps its normal";
+  {
+    if (&p != moved)
+    {
+      EXPECT_GT(std::abs(p.normal.dot(wall)), std::cos(1e-3)) << "the wall keeps its normal";
+    }
+  }
   restored.frame({restored.plane(wall, -3.0, 40000), front(restored, tilt)}, 3, camera(3));
   EXPECT_EQ(restored.map.serialize(), moving.map.serialize());
 

@@ -211,19 +211,17 @@ bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::
 {
   // Two nearby peaks are two surfaces when one frame measured a plane at each (two box tops a
   // few cm apart), or the map already held them apart; else they are one plane's measurements.
-  auto cost = [&](const Eigen::Vector3d& normal, double d, const HoughPeak& peak) {
-    return mergeCost(normal, d, peak.normal, peak.d);
-  };
+  auto cost = [&](const auto& plane, const HoughPeak& peak) { return mergeCost(plane.normal, plane.d, peak.normal, peak.d); };
   // Planes of one list, one nearer each peak, that are two surfaces themselves.
   auto apart = [&](const auto& planes, const auto& two_surfaces) {
     for (const auto& near_a : planes)
     {
-      const double a_to_a = cost(near_a.normal, near_a.d, a);
-      if (a_to_a > 1.0 || a_to_a >= cost(near_a.normal, near_a.d, b)) continue;
+      const double a_to_a = cost(near_a, a);
+      if (a_to_a > 1.0 || a_to_a >= cost(near_a, b)) continue;
       for (const auto& near_b : planes)
       {
-        const double b_to_b = cost(near_b.normal, near_b.d, b);
-        if (b_to_b > 1.0 || b_to_b >= cost(near_b.normal, near_b.d, a)) continue;
+        const double b_to_b = cost(near_b, b);
+        if (b_to_b > 1.0 || b_to_b >= cost(near_b, a)) continue;
         if (two_surfaces(near_a, near_b)) return true;
       }
     }
