@@ -304,6 +304,7 @@ RandomSceneExperiment runRandomScenes(bool quick)
   result.frames = quick ? 12 : 30;
   result.held_out_seeds = quick ? 5 : kHeldOutSeeds.size();
   result.second_held_out_seeds = quick ? 5 : kSecondHeldOutSeeds.size();
+  result.third_held_out_seeds = quick ? 5 : kThirdHeldOutSeeds.size();
   result.tuning_seeds = quick ? 3 : kTuningSeeds.size();
   // The default and what each of its own rules adds (ablations), then the region stage.
   struct Variant
@@ -365,16 +366,23 @@ RandomSceneExperiment runRandomScenes(bool quick)
     runSeed(kHeldOutSeeds[i], at_c1, false, 1.0, true);
   }
   result.held_out_at_c1 = at_c1.front();
-  // The second list: the defaults only (variants[0]), pooled with the first in the verdicts.
-  std::vector<MethodStats> second(1), second_at_c1(1);
-  for (size_t i = 0; i < result.second_held_out_seeds; ++i)
-  {
-    std::fprintf(stderr, "  second held-out seed %u\n", kSecondHeldOutSeeds[i]);
-    runSeed(kSecondHeldOutSeeds[i], second, false, 0.0, true);
-    runSeed(kSecondHeldOutSeeds[i], second_at_c1, false, 1.0, true);
-  }
-  result.second_held_out = second.front();
-  result.second_held_out_at_c1 = second_at_c1.front();
+  // The later lists: the defaults only (variants[0]), pooled with the first in the verdicts.
+  auto runList = [&](const char* which, const std::vector<uint32_t>& seeds, size_t count, MethodStats& own_c,
+                     MethodStats& c1) {
+    std::vector<MethodStats> at_own(1), at_one(1);
+    for (size_t i = 0; i < count; ++i)
+    {
+      std::fprintf(stderr, "  %s held-out seed %u\n", which, seeds[i]);
+      runSeed(seeds[i], at_own, false, 0.0, true);
+      runSeed(seeds[i], at_one, false, 1.0, true);
+    }
+    own_c = at_own.front();
+    c1 = at_one.front();
+  };
+  runList("second", kSecondHeldOutSeeds, result.second_held_out_seeds, result.second_held_out,
+          result.second_held_out_at_c1);
+  runList("third", kThirdHeldOutSeeds, result.third_held_out_seeds, result.third_held_out,
+          result.third_held_out_at_c1);
   return result;
 }
 

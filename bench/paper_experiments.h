@@ -149,9 +149,10 @@ struct RandomSceneExperiment
   std::vector<std::string> variants;           // the defaults first, the paper's windows last
   std::vector<MethodStats> held_out, tuning;   // by variant
   MethodStats held_out_at_c1;                  // the defaults on the held-out rooms rendered at C = 1
-  // The second held-out list (kSecondHeldOutSeeds), the defaults only, at each room's C and at C = 1.
-  MethodStats second_held_out, second_held_out_at_c1;
-  size_t held_out_seeds = 0, second_held_out_seeds = 0, tuning_seeds = 0;
+  // The later held-out lists (kSecondHeldOutSeeds, kThirdHeldOutSeeds), the defaults only, at
+  // each room's C and at C = 1.
+  MethodStats second_held_out, second_held_out_at_c1, third_held_out, third_held_out_at_c1;
+  size_t held_out_seeds = 0, second_held_out_seeds = 0, third_held_out_seeds = 0, tuning_seeds = 0;
   std::vector<HeldOutRoom> rooms;              // the held-out seeds one by one
 };
 RandomSceneExperiment runRandomScenes(bool quick);

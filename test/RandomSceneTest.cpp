@@ -28,13 +28,15 @@ TEST(RandomScene, ASeedAlwaysGivesTheSameRoomAndOthersDiffer)
   EXPECT_NE(a.description, other.description);
 }
 
-// Both held-out lists: no seed twice, and none on the tuning or development lists.
+// The held-out lists: no seed twice, and none on the tuning or development lists.
 TEST(RandomScene, HeldOutAndTuningSeedsAreDisjoint)
 {
   std::set<uint32_t> held_out(kHeldOutSeeds.begin(), kHeldOutSeeds.end());
   EXPECT_GE(held_out.size(), 20u);
   for (uint32_t seed : kSecondHeldOutSeeds) EXPECT_TRUE(held_out.insert(seed).second) << "listed twice: " << seed;
   EXPECT_GE(held_out.size(), 60u);
+  for (uint32_t seed : kThirdHeldOutSeeds) EXPECT_TRUE(held_out.insert(seed).second) << "listed twice: " << seed;
+  EXPECT_GE(held_out.size(), 100u);
   for (const auto* tuned : {&kTuningSeeds, &kDevelopmentSeeds, &kSecondDevelopmentSeeds})
     for (uint32_t seed : *tuned) EXPECT_EQ(held_out.count(seed), 0u) << seed;
 }
