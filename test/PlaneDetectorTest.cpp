@@ -255,6 +255,35 @@ TEST(PlaneDetector, TwoPanelsAStepApartGrownAsOneRegionAreSplitIntoTheirPlanes)
   }
 }
 
+// Two table tops 1.8 cm apart in height lie within one Hough peak (d cells of 1 cm, a 5-cell
+// window): their votes climb to one maximum. A frame measures them apart (millimetre offset
+// errors), so the map holds both, each at its own height, and keeps the second while the
+// camera looks at the first alone.
+TEST(PlaneDetector, TwoTableTopsCloserThanAHoughPeakStayTwoPlanes)
+{
+  Scene scene;
+  scene.addRectangle({2.0, 0.0, 0.0}, kX, kY, 3.0, 3.0, "floor");
+  scene.addRectangle({1.5, -0.45, 0.750}, kX, kY, 0.4, 0.4, "low_top");
+  scene.addRectangle({1.5, 0.45, 0.768}, kX, kY, 0.4, 0.4, "high_top");
+  const SceneRenderer renderer(scene);
+  PlaneDetector detector{DetectorParams()};
+  auto tops = [&] {
+    return std::make_pair(matching(detector.planes(), kZ, -0.750, 0.01, 0.006).size(),
+                          matching(detector.planes(), kZ, -0.768, 0.01, 0.006).size());
+  };
+  for (int f = 0; f < 8; ++f)
+  {
+    feed(detector, renderer.render(lookAt({0.0, 0.02 * f, 1.5}, {1.5, 0.0, 0.75}), kinect(1.0), f), 0.1 * f);
+    EXPECT_EQ(tops(), std::make_pair(size_t(1), size_t(1))) << "frame " << f << describe(detector.planes());
+  }
+  // The camera turns to the low table alone: the high one is out of view and stays.
+  for (int f = 8; f < 14; ++f)
+  {
+    feed(detector, renderer.render(lookAt({0.0, -0.9, 1.5}, {1.5, -0.9, 0.75}), kinect(1.0), f), 0.1 * f);
+    EXPECT_EQ(tops(), std::make_pair(size_t(1), size_t(1))) << "frame " << f << describe(detector.planes());
+  }
+}
+
 // A new panel 30 cm wide turned 0.08 rad off a known wall and 5 cm before it lies within three
 // merge tolerances of it: that may be the wall measured badly, so it is not reported at first
 // sight, while the same panel turned 0.3 rad is reported the first time a frame measures it.

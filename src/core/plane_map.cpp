@@ -79,14 +79,106 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   const int evicted = static_cast<int>(global_.evictWeakest(static_cast<size_t>(params_.max_chunks)));
   chunks_evicted_total_ += evicted;
 
+  std::vector<HoughPeak> extracted = peak_search_.extract(global_, seeds, params_.global_threshold, full_height);
+  addCloseSurfacePeaks(frame_planes, extracted);
   const std::vector<HoughPeak> peaks =
-      mergeSimilarPeaks(peak_search_.extract(global_, seeds, params_.global_threshold, full_height),
+      mergeSimilarPeaks(std::move(extracted),
                         params_.merge_angle, params_.merge_distance, param_,
                         [&](const HoughPeak& a, const HoughPeak& b) { return measuredApart(a, b, frame_planes); });
   matchIds(peaks, camera_position, stamp);
   if (params_.forgetting == kForgetByEvidence) carryBeliefs();
   reseatRefutedSnaps(frame_planes, camera_position);
   return evicted;
+}
+
+void PlaneMap::addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes, std::vector<HoughPeak>& peaks) const
+{
+  // The grid cannot resolve two parallel surfaces a cell or two apart (two table tops 1.5 cm
+  // apart): their votes climb to one maximum, whose mean lies between them. When this frame
+  // measured them apart beyond their noise, or the map held them apart, each surface gets a
+  // peak of its own at its own place: as this frame measured it, else as the map held it.
+  const int64_t sy = global_.sizeY(), sz = global_.sizeZ();
+  auto top_of = [&](const Eigen::Vector3d& hough) {
+    const Eigen::Vector3i c = peak_search_.climb(global_, nearestCell(param_.toCell(hough)));
+    return (static_cast<int64_t>(c.x()) * sy + c.y()) * sz + c.z();
+  };
+  std::vector<int64_t> frame_tops, map_tops;
+  for (const FramePlane& measured : frame_planes) frame_tops.push_back(top_of(measured.hough));
+  for (const DetectedPlane& plane : planes_) map_tops.push_back(top_of(plane.hough));
+  auto cost = [&](const auto& a, const auto& b) { return mergeCost(a.normal, a.d, b.normal, b.d); };
+  const size_t extracted = peaks.size();
+  for (size_t k = 0; k < extracted; ++k)
+  {
+    const int64_t top = top_of(peaks[k].hough);
+    // This frame's surfaces on the peak: the plane nearest it, then, best supported first, each
+    // one precise enough to be reported at first sight and apart from those already taken.
+    std::vector<const FramePlane*> measured;
+    for (size_t i = 0; i < frame_planes.size(); ++i)
+      if (frame_tops[i] == top) measured.push_back(&frame_planes[i]);
+    std::stable_sort(measured.begin(), measured.end(),
+                     [](const FramePlane* a, const FramePlane* b) { return a->support > b->support; });
+    const auto nearest = std::min_element(measured.begin(), measured.end(), [&](const FramePlane* a, const FramePlane* b) {
+      return cost(*a, peaks[k]) < cost(*b, peaks[k]);
+    });
+    if (nearest != measured.end()) std::rotate(measured.begin(), nearest, std::next(nearest));
+    // Two surfaces that share a maximum are parallel within their normals' noise (a box top
+    // beside a table top, both snapped to the floor's normal); a region tilted beyond it and
+    // offset too is one surface's biased fit (a far stretch of floor), not a second surface.
+    auto parallel = [](const FramePlane& a, const FramePlane& b) {
+      return unsignedAngle(a.normal, b.normal) <=
+             3.0 * std::sqrt(a.normal_sigma * a.normal_sigma + b.normal_sigma * b.normal_sigma);
+    };
+    // Both sides of a split are measurements a first sight would report: one that does not fit
+    // its blocks, or is imprecise, says nothing about a second surface beside it.
+    auto trusted = [&](const FramePlane& p) { return p.fits_its_blocks && preciseAtFirstSight(p); };
+    std::vector<const FramePlane*> surfaces;
+    for (const FramePlane* plane : measured)
+      if (surfaces.empty() ||
+          (trusted(*surfaces.front()) && trusted(*plane) &&
+           std::all_of(surfaces.begin(), surfaces.end(), [&](const FramePlane* s) {
+             return distinctSurfaces(*plane, *s) && parallel(*plane, *s);
+           })))
+        surfaces.push_back(plane);
+    // The map's planes on the peak that no surface of this frame re-measured (none is nearer it
+    // than to the others of the map): the one nearest the peak, and those held apart that later
+    // frames' depths confirmed (not tentative).
+    std::vector<const DetectedPlane*> on_peak;
+    for (size_t i = 0; i < planes_.size(); ++i)
+      if (map_tops[i] == top) on_peak.push_back(&planes_[i]);
+    const DetectedPlane* map_nearest = nullptr;
+    for (const DetectedPlane* plane : on_peak)
+      if (!map_nearest || cost(*plane, peaks[k]) < cost(*map_nearest, peaks[k])) map_nearest = plane;
+    std::vector<const DetectedPlane*> held;
+    for (const DetectedPlane* plane : on_peak)
+    {
+      const bool remeasured = std::any_of(surfaces.begin(), surfaces.end(), [&](const FramePlane* s) {
+        return std::none_of(on_peak.begin(), on_peak.end(), [&](const DetectedPlane* o) { return cost(*o, *s) < cost(*plane, *s); });
+      });
+      if (remeasured) continue;
+      const auto belief = beliefs_.find(plane->id);
+      const bool confirmed = belief != beliefs_.end() && !belief->second.tentative() && !belief->second.gone();
+      if ((surfaces.empty() && plane == map_nearest) || confirmed) held.push_back(plane);
+    }
+    std::vector<Eigen::Vector3d> places;
+    for (const FramePlane* plane : surfaces) places.push_back(plane->hough);
+    for (const DetectedPlane* plane : held) places.push_back(plane->hough);
+    if (places.size() < 2) continue;
+    // The first takes the maximum's height; each other stands on its own cell's.
+    for (size_t i = 0; i < places.size(); ++i)
+    {
+      HoughPeak own = peaks[k];
+      own.hough = places[i];
+      param_.fromHough(own.hough, own.normal, own.d);
+      if (i == 0)
+      {
+        peaks[k] = own;
+        continue;
+      }
+      const Eigen::Vector3i c = nearestCell(param_.toCell(own.hough));
+      own.value = global_.value(c.x(), c.y(), c.z());
+      if (own.value >= params_.global_threshold) peaks.push_back(own);
+    }
+  }
 }
 
 void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, const Eigen::Vector3d& camera_position)
@@ -183,6 +275,14 @@ void PlaneMap::addVote(const Eigen::Vector3d& hough, float weight, float cap)
 
 void PlaneMap::clearOwnPeakCells(size_t index)
 {
+  forOwnPeakCells(index, [&](int x, int y, int z) {
+    const float v = global_.value(x, y, z);
+    if (v > 0.0f) global_.add(x, y, z, -v);
+  });
+}
+
+void PlaneMap::forOwnPeakCells(size_t index, const std::function<void(int, int, int)>& f) const
+{
   // Cells nearer another map plane's peak are that plane's votes, however close the two lie.
   std::vector<Eigen::Vector3d> others;
   for (size_t p = 0; p < planes_.size(); ++p)
@@ -196,14 +296,12 @@ void PlaneMap::clearOwnPeakCells(size_t index)
   Eigen::Vector3d mirrored;
   if (param_.mirror(planes_[index].hough, mirrored)) own.push_back(param_.toCell(mirrored));
   forPeakCells(planes_[index].hough, [&](int x, int y, int z) {
-    const float v = global_.value(x, y, z);
-    if (v <= 0.0f) return;
     const Eigen::Vector3d cell(x, y, z);
     double nearest_own = std::numeric_limits<double>::infinity();
     for (const Eigen::Vector3d& c : own) nearest_own = std::min(nearest_own, (cell - c).squaredNorm());
     for (const Eigen::Vector3d& c : others)
       if ((cell - c).squaredNorm() < nearest_own) return;
-    global_.add(x, y, z, -v);
+    f(x, y, z);
   });
 }
 
@@ -313,9 +411,11 @@ void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
   // A young plane (peak at most 2: one first-sight vote or two plain ones) that this frame does
   // not measure again, while it measures a plane of at least its support within three merge
   // tolerances of it, was that surface measured badly: the better measurement replaces it
-  // rather than stand beside it.
-  for (const DetectedPlane& plane : planes_)
+  // rather than stand beside it. Only its own cells go: a neighbour's peak (a surface beside
+  // it) keeps its votes.
+  for (size_t p = 0; p < planes_.size(); ++p)
   {
+    const DetectedPlane& plane = planes_[p];
     if (plane.strength > 2.0 || remeasured(plane, frame_planes)) continue;
     for (const FramePlane& measured : frame_planes)
     {
@@ -323,7 +423,7 @@ void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
           !withinMergeTolerances(plane.normal, plane.d, measured.normal, measured.d,
                                  kNearTolerances * params_.merge_angle, kNearTolerances * params_.merge_distance))
         continue;
-      clearPeakCells(plane.hough);
+      clearOwnPeakCells(p);
       break;
     }
   }
@@ -494,13 +594,15 @@ void PlaneMap::thinByEvidence(float cap, const std::vector<FramePlane>& frame_pl
   // mirrored copy near the border) are kept as they are, a gone plane's are cleared; a plane
   // not yet established thins like everything else, a tentative one faster.
   std::vector<std::pair<Eigen::Vector3i, float>> kept;
-  for (const DetectedPlane& plane : planes_)
+  for (size_t p = 0; p < planes_.size(); ++p)
   {
-    const auto belief = beliefs_.find(plane.id);
+    const auto belief = beliefs_.find(planes_[p].id);
+    // A gone plane's whole window is cleared, a neighbour's votes within it too: two peaks
+    // that close pulled each other's means, so the neighbour restarts from the frames.
     if (belief != beliefs_.end() && belief->second.gone())
-      clearPeakCells(plane.hough);
+      clearPeakCells(planes_[p].hough);
     else if (belief != beliefs_.end() && belief->second.established())
-      forPeakCells(plane.hough, [&](int x, int y, int z) {
+      forOwnPeakCells(p, [&](int x, int y, int z) {
         const float v = global_.value(x, y, z);
         if (v > 0.0f) kept.emplace_back(Eigen::Vector3i(x, y, z), v);
       });
@@ -509,11 +611,11 @@ void PlaneMap::thinByEvidence(float cap, const std::vector<FramePlane>& frame_pl
   // again loses half a vote, thinning included: one view's hypothesis leaves unless seen again,
   // as a tracker's tentative tracks do (after the established planes' cells are noted above).
   const float tentative_fade = static_cast<float>(std::max(0.0, PlaneBelief::kTentativeFade - params_.thinning_rate));
-  for (const DetectedPlane& plane : planes_)
+  for (size_t p = 0; p < planes_.size(); ++p)
   {
-    const auto belief = beliefs_.find(plane.id);
-    if (belief == beliefs_.end() || !belief->second.tentative() || remeasured(plane, frame_planes)) continue;
-    forPeakCells(plane.hough, [&](int x, int y, int z) {
+    const auto belief = beliefs_.find(planes_[p].id);
+    if (belief == beliefs_.end() || !belief->second.tentative() || remeasured(planes_[p], frame_planes)) continue;
+    forOwnPeakCells(p, [&](int x, int y, int z) {
       const float v = global_.value(x, y, z);
       if (v > 0.0f) global_.add(x, y, z, -std::min(v, tentative_fade));
     });

@@ -106,6 +106,10 @@ private:
   void forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const;
   // True when one of this frame's planes lies on `plane` within the merge tolerances.
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
+  // Two surfaces closer than a peak window share one maximum: when this frame measured them
+  // apart, or the map held them apart and depths confirmed them, the maximum's peak moves to
+  // one of them and each other gets a peak at its own place (this frame's, else the map's).
+  void addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes, std::vector<HoughPeak>& peaks) const;
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
   bool measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const;
   // True when two planes one frame measured are two surfaces: not similar by eq. 7-8, or their
@@ -129,7 +133,10 @@ private:
   double mergeCost(const Eigen::Vector3d& normal_a, double d_a, const Eigen::Vector3d& normal_b, double d_b) const;
   // One Gaussian vote at `hough`, and at its mirrored copy near the border.
   void addVote(const Eigen::Vector3d& hough, float weight, float cap);
-  // Zeroes the cells forPeakCells visits around planes_[index] that lie nearer its peak than any other plane's.
+  // Calls f on the cells forPeakCells visits around planes_[index] that lie nearer its peak
+  // than any other plane's: a neighbour's votes are not its own, however close the two lie.
+  void forOwnPeakCells(size_t index, const std::function<void(int, int, int)>& f) const;
+  // Zeroes the cells forOwnPeakCells visits.
   void clearOwnPeakCells(size_t index);
 
   const DetectorParams& params_;
