@@ -284,17 +284,29 @@ void PlaneMap::clearOwnPeakCells(size_t index)
 void PlaneMap::forOwnPeakCells(size_t index, const std::function<void(int, int, int)>& f) const
 {
   // Cells nearer another map plane's peak are that plane's votes, however close the two lie.
-  std::vector<Eigen::Vector3d> others;
-  for (size_t p = 0; p < planes_.size(); ++p)
-  {
-    if (p == index) continue;
-    others.push_back(param_.toCell(planes_[p].hough));
-    Eigen::Vector3d mirrored;
-    if (param_.mirror(planes_[p].hough, mirrored)) others.push_back(param_.toCell(mirrored));
-  }
   std::vector<Eigen::Vector3d> own{param_.toCell(planes_[index].hough)};
   Eigen::Vector3d mirrored;
   if (param_.mirror(planes_[index].hough, mirrored)) own.push_back(param_.toCell(mirrored));
+  // A visited cell lies within sqrt(3) (r + 1/2) of an own centre (r: forPeakCells' reach, plus
+  // the rounding of the centre), so only a peak within twice that can be nearer to it.
+  const double reach = 2.0 * std::sqrt(3.0) * (voting_.blurRadius() + params_.peak_window / 2 + 1.5);
+  std::vector<Eigen::Vector3d> others;
+  auto consider = [&](const Eigen::Vector3d& hough) {
+    const Eigen::Vector3d c = param_.toCell(hough);
+    for (const Eigen::Vector3d& o : own)
+      if ((c - o).squaredNorm() <= reach * reach)
+      {
+        others.push_back(c);
+        return;
+      }
+  };
+  for (size_t p = 0; p < planes_.size(); ++p)
+  {
+    if (p == index) continue;
+    consider(planes_[p].hough);
+    Eigen::Vector3d other_mirrored;
+    if (param_.mirror(planes_[p].hough, other_mirrored)) consider(other_mirrored);
+  }
   forPeakCells(planes_[index].hough, [&](int x, int y, int z) {
     const Eigen::Vector3d cell(x, y, z);
     double nearest_own = std::numeric_limits<double>::infinity();
