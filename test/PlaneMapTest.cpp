@@ -273,6 +273,67 @@ TEST(PlaneMap, TwoSurfacesOneFrameMeasuredCloserThanTheMergeDistanceStayTwo)
   EXPECT_EQ(split.map.planes().size(), 1u);
 }
 
+// Two table tops 1.8 cm apart (two d cells) climb to one maximum of the space; one frame that
+// measured both, each fitting its blocks and precise, parts them (addCloseSurfacePeaks). The
+// split needs both sides trusted and parallel within their normals' noise: a region that does
+// not fit its blocks, or one tilted beyond that noise, beside the floor is that floor fitted
+// badly (a snapped stretch of floor 0.012 rad off in a held-out room), not a second surface,
+// and the maximum stays one plane.
+TEST(PlaneMap, ASharedMaximumSplitsOnlyForTwoTrustedParallelSurfaces)
+{
+  auto measured = [](FramePlane plane, const Eigen::Vector3d& centroid, double normal_sigma, bool fits) {
+    plane.centroid = centroid;
+    plane.offset_sigma = 0.001;
+    plane.normal_sigma = normal_sigma;
+    plane.fits_its_blocks = fits;
+    return plane;
+  };
+  const Eigen::Vector3d camera(0.0, 0.0, 1.5);
+  Map tops;
+  tops.frame({measured(tops.plane(kFloor, -0.750, 20000), Eigen::Vector3d(1.5, -0.45, 0.750), 0.002, true),
+              measured(tops.plane(kFloor, -0.768, 20000), Eigen::Vector3d(1.5, 0.45, 0.768), 0.002, true)},
+             0.0, camera);
+  std::vector<double> d;
+  for (const DetectedPlane& plane : tops.map.planes()) d.push_back(std::abs(plane.d));
+  std::sort(d.begin(), d.end());
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_NEAR(d[0], 0.750, 0.006);
+  EXPECT_NEAR(d[1], 0.768, 0.006);
+
+  // A floor seen for a while and, in each of the next six frames, a region 20 cm beside and
+  // 2.5 cm above its centroid, tilted 0.012 rad: its votes climb to the floor's maximum, and by
+  // their offsets the two would be two surfaces (distinctSurfaces) were the region trusted and
+  // parallel to it. Without the guard its own peak becomes a second plane from the second frame.
+  const Eigen::Vector3d tilted = Eigen::AngleAxisd(0.012, Eigen::Vector3d::UnitX()) * kFloor;
+  const Eigen::Vector3d off_centroid(2.0, 0.5, 0.025);
+  struct Case
+  {
+    double normal_sigma;
+    bool fits;
+    const char* what;
+  };
+  for (const Case& c : {Case{0.05, false, "not fitting its blocks"}, Case{0.002, true, "tilted beyond its noise"}})
+  {
+    Map floor;
+    const FramePlane seen = measured(floor.plane(kFloor, 0.0, 20000), Eigen::Vector3d(2.0, 0.3, 0.0), 0.002, true);
+    for (int f = 0; f < 6; ++f) floor.frame({seen}, f, camera);
+    const FramePlane region =
+        measured(floor.plane(tilted, -tilted.dot(off_centroid), 20000), off_centroid, c.normal_sigma, c.fits);
+    for (int f = 6; f < 12; ++f)
+    {
+      floor.frame({seen, region}, f, camera);
+      if (floor.map.planes().size() != 1u)
+      {
+        ADD_FAILURE() << c.what << ", frame " << f << ": " << floor.map.planes().size() << " planes";
+        break;
+      }
+      EXPECT_LT(std::acos(std::abs(floor.map.planes()[0].normal.z())), 0.003) << c.what << ", frame " << f;
+      // The region's votes pull the shared maximum's mean a few millimetres off the floor.
+      EXPECT_LT(std::abs(floor.map.planes()[0].d), 0.006) << c.what << ", frame " << f;
+    }
+  }
+}
+
 // A plane one frame raised that no later frame supports: the paper's thinning takes it away at
 // thinning_rate a frame; forgetting by evidence (the default) takes a tentative plane away at
 // PlaneBelief::kTentativeFade a frame.
