@@ -77,9 +77,16 @@ TEST(HoughPeaks, SeedsOfOnePeakGiveItOnceAndTheThresholdDropsWeakOnes)
   s.gaussianAt(Eigen::Vector3d(140, 90, 1200), 3.0f);
   const std::vector<Eigen::Vector3i> seeds{{100, 100, 800}, {101, 99, 801}, {140, 90, 1200}, {141, 90, 1199}};
   EXPECT_EQ(s.search.extract(s.space, seeds, 1.0).size(), 2u);
-  const std::vector<HoughPeak> strong = s.search.extract(s.space, seeds, 5.0);
+  // Every seed reports the top it climbed to, also those of a peak under the threshold.
+  std::vector<Eigen::Vector3i> tops;
+  const std::vector<HoughPeak> strong = s.search.extract(s.space, seeds, 5.0, {}, &tops);
   ASSERT_EQ(strong.size(), 1u);
   EXPECT_FLOAT_EQ(static_cast<float>(strong[0].value), 10.0f);
+  ASSERT_EQ(tops.size(), seeds.size());
+  EXPECT_EQ(tops[0], Eigen::Vector3i(100, 100, 800));
+  EXPECT_EQ(tops[1], tops[0]);
+  EXPECT_EQ(tops[2], Eigen::Vector3i(140, 90, 1200));
+  EXPECT_EQ(tops[3], tops[2]);
 }
 
 TEST(HoughPeaks, MergeJoinsSimilarPlanesByTheirValues)

@@ -104,14 +104,17 @@ double HoughPeakSearch::peakHeight(const SparseHoughSpace& space, const Eigen::V
 }
 
 std::vector<HoughPeak> HoughPeakSearch::extract(const SparseHoughSpace& space, const std::vector<Eigen::Vector3i>& seeds,
-                                                double threshold, const std::vector<char>& full_height) const
+                                                double threshold, const std::vector<char>& full_height,
+                                                std::vector<Eigen::Vector3i>* seed_tops) const
 {
+  if (seed_tops) seed_tops->clear();
   std::vector<HoughPeak> peaks;
   std::unordered_set<int64_t> visited;
   const int64_t sy = space.sizeY(), sz = space.sizeZ();
   for (size_t i = 0; i < seeds.size(); ++i)
   {
     const Eigen::Vector3i top = climb(space, seeds[i]);
+    if (seed_tops) seed_tops->push_back(top);
     if (!visited.insert((static_cast<int64_t>(top.x()) * sy + top.y()) * sz + top.z()).second) continue;
     const float value = space.value(top.x(), top.y(), top.z());
     const bool by_height = i < full_height.size() && full_height[i];

@@ -79,8 +79,10 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   const int evicted = static_cast<int>(global_.evictWeakest(static_cast<size_t>(params_.max_chunks)));
   chunks_evicted_total_ += evicted;
 
-  std::vector<HoughPeak> extracted = peak_search_.extract(global_, seeds, params_.global_threshold, full_height);
-  addCloseSurfacePeaks(frame_planes, extracted);
+  std::vector<Eigen::Vector3i> seed_tops;
+  std::vector<HoughPeak> extracted =
+      peak_search_.extract(global_, seeds, params_.global_threshold, full_height, &seed_tops);
+  addCloseSurfacePeaks(frame_planes, seed_tops, extracted);
   const std::vector<HoughPeak> peaks =
       mergeSimilarPeaks(std::move(extracted),
                         params_.merge_angle, params_.merge_distance, param_,
@@ -91,25 +93,20 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   return evicted;
 }
 
-void PlaneMap::addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes, std::vector<HoughPeak>& peaks) const
+void PlaneMap::addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes,
+                                    const std::vector<Eigen::Vector3i>& seed_tops, std::vector<HoughPeak>& peaks) const
 {
   // The grid cannot resolve two parallel surfaces a cell or two apart (two table tops 1.5 cm
   // apart): their votes climb to one maximum, whose mean lies between them. When this frame
   // measured them apart beyond their noise, or the map held them apart, each surface gets a
   // peak of its own at its own place: as this frame measured it, else as the map held it.
-  const int64_t sy = global_.sizeY(), sz = global_.sizeZ();
-  auto top_of = [&](const Eigen::Vector3d& hough) {
-    const Eigen::Vector3i c = peak_search_.climb(global_, nearestCell(param_.toCell(hough)));
-    return (static_cast<int64_t>(c.x()) * sy + c.y()) * sz + c.z();
-  };
-  std::vector<int64_t> frame_tops, map_tops;
-  for (const FramePlane& measured : frame_planes) frame_tops.push_back(top_of(measured.hough));
-  for (const DetectedPlane& plane : planes_) map_tops.push_back(top_of(plane.hough));
-  auto cost = [&](const auto& a, const auto& b) { return mergeCost(a.normal, a.d, b.normal, b.d); };
+  // The extraction's climbs from each frame plane's and map plane's cell (the seeds).
+  const auto frame_tops = seed_tops.begin();
+  const auto map_tops = seed_tops.begin() + static_cast<std::ptrdiff_t>(frame_planes.size());
   const size_t extracted = peaks.size();
   for (size_t k = 0; k < extracted; ++k)
   {
-    const int64_t top = top_of(peaks[k].hough);
+    const Eigen::Vector3i top = peak_search_.climb(global_, nearestCell(param_.toCell(peaks[k].hough)));
     // This frame's surfaces on the peak: the plane nearest it, then, best supported first, each
     // one precise enough to be reported at first sight and apart from those already taken.
     std::vector<const FramePlane*> measured;
@@ -117,9 +114,10 @@ void PlaneMap::addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes,
       if (frame_tops[i] == top) measured.push_back(&frame_planes[i]);
     std::stable_sort(measured.begin(), measured.end(),
                      [](const FramePlane* a, const FramePlane* b) { return a->support > b->support; });
-    const auto nearest = std::min_element(measured.begin(), measured.end(), [&](const FramePlane* a, const FramePlane* b) {
-      return cost(*a, peaks[k]) < cost(*b, peaks[k]);
-    });
+    const auto nearest =
+        std::min_element(measured.begin(), measured.end(), [&](const FramePlane* a, const FramePlane* b) {
+          return mergeCost(*a, peaks[k]) < mergeCost(*b, peaks[k]);
+        });
     if (nearest != measured.end()) std::rotate(measured.begin(), nearest, std::next(nearest));
     // Two surfaces that share a maximum are parallel within their normals' noise (a box top
     // beside a table top, both snapped to the floor's normal); a region tilted beyond it and
@@ -147,12 +145,13 @@ void PlaneMap::addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes,
       if (map_tops[i] == top) on_peak.push_back(&planes_[i]);
     const DetectedPlane* map_nearest = nullptr;
     for (const DetectedPlane* plane : on_peak)
-      if (!map_nearest || cost(*plane, peaks[k]) < cost(*map_nearest, peaks[k])) map_nearest = plane;
+      if (!map_nearest || mergeCost(*plane, peaks[k]) < mergeCost(*map_nearest, peaks[k])) map_nearest = plane;
     std::vector<const DetectedPlane*> held;
     for (const DetectedPlane* plane : on_peak)
     {
       const bool remeasured = std::any_of(surfaces.begin(), surfaces.end(), [&](const FramePlane* s) {
-        return std::none_of(on_peak.begin(), on_peak.end(), [&](const DetectedPlane* o) { return cost(*o, *s) < cost(*plane, *s); });
+        return std::none_of(on_peak.begin(), on_peak.end(),
+                            [&](const DetectedPlane* o) { return mergeCost(*o, *s) < mergeCost(*plane, *s); });
       });
       if (remeasured) continue;
       const auto belief = beliefs_.find(plane->id);
@@ -199,7 +198,7 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
     for (size_t p = 0; p < planes_.size(); ++p)
     {
       if (!samePlane(planes_[p], measured)) continue;
-      const double cost = mergeCost(measured.normal, measured.d, planes_[p].normal, planes_[p].d);
+      const double cost = mergeCost(measured, planes_[p]);
       if (match < 0 || cost < best_cost)
       {
         match = static_cast<int>(p);
@@ -321,17 +320,16 @@ bool PlaneMap::measuredApart(const HoughPeak& a, const HoughPeak& b, const std::
 {
   // Two nearby peaks are two surfaces when one frame measured a plane at each (two box tops a
   // few cm apart), or the map already held them apart; else they are one plane's measurements.
-  auto cost = [&](const auto& plane, const HoughPeak& peak) { return mergeCost(plane.normal, plane.d, peak.normal, peak.d); };
   // Planes of one list, one nearer each peak, that are two surfaces themselves.
   auto apart = [&](const auto& planes, const auto& two_surfaces) {
     for (const auto& near_a : planes)
     {
-      const double a_to_a = cost(near_a, a);
-      if (a_to_a > 1.0 || a_to_a >= cost(near_a, b)) continue;
+      const double a_to_a = mergeCost(near_a, a);
+      if (a_to_a > 1.0 || a_to_a >= mergeCost(near_a, b)) continue;
       for (const auto& near_b : planes)
       {
-        const double b_to_b = cost(near_b, b);
-        if (b_to_b > 1.0 || b_to_b >= cost(near_b, a)) continue;
+        const double b_to_b = mergeCost(near_b, b);
+        if (b_to_b > 1.0 || b_to_b >= mergeCost(near_b, a)) continue;
         if (two_surfaces(near_a, near_b)) return true;
       }
     }

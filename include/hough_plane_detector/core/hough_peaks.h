@@ -30,9 +30,11 @@ public:
 
   // Peaks reached from the seeds, each once, at least `threshold` high.
   // A peak reached from a seed marked in `full_height` is judged by its height between the
-  // cells (peakHeight), not by its cell's value.
+  // cells (peakHeight), not by its cell's value. `seed_tops`, when given, receives the cell each
+  // seed climbed to, in the seeds' order.
   std::vector<HoughPeak> extract(const SparseHoughSpace& space, const std::vector<Eigen::Vector3i>& seeds,
-                                 double threshold, const std::vector<char>& full_height = {}) const;
+                                 double threshold, const std::vector<char>& full_height = {},
+                                 std::vector<Eigen::Vector3i>* seed_tops = nullptr) const;
   // Climbs from a cell to the local maximum under the (value, -index) total order.
   Eigen::Vector3i climb(const SparseHoughSpace& space, Eigen::Vector3i cell) const;
   // True when no cell of the peak window beats the cell under that order.

@@ -109,7 +109,9 @@ private:
   // Two surfaces closer than a peak window share one maximum: when this frame measured them
   // apart, or the map held them apart and depths confirmed them, the maximum's peak moves to
   // one of them and each other gets a peak at its own place (this frame's, else the map's).
-  void addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes, std::vector<HoughPeak>& peaks) const;
+  // `seed_tops`: the cell each frame plane, then each map plane, climbed to in this space.
+  void addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes, const std::vector<Eigen::Vector3i>& seed_tops,
+                            std::vector<HoughPeak>& peaks) const;
   // True when this frame's planes, or the map's, lie one near each peak: two surfaces.
   bool measuredApart(const HoughPeak& a, const HoughPeak& b, const std::vector<FramePlane>& frame_planes) const;
   // True when two planes one frame measured are two surfaces: not similar by eq. 7-8, or their
@@ -131,6 +133,12 @@ private:
   void reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, const Eigen::Vector3d& camera_position);
   // How far apart two planes are in merge tolerances (angle / merge_angle + offset / merge_distance).
   double mergeCost(const Eigen::Vector3d& normal_a, double d_a, const Eigen::Vector3d& normal_b, double d_b) const;
+  // The same for any two planes or peaks (members normal and d).
+  template <class A, class B>
+  double mergeCost(const A& a, const B& b) const
+  {
+    return mergeCost(a.normal, a.d, b.normal, b.d);
+  }
   // One Gaussian vote at `hough`, and at its mirrored copy near the border.
   void addVote(const Eigen::Vector3d& hough, float weight, float cap);
   // Calls f on the cells forPeakCells visits around planes_[index] that lie nearer its peak
