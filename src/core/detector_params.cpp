@@ -68,6 +68,8 @@ bool DetectorParams::validate(std::string* error) const
   if (parallel_support < 0) err << "parallel_support must be >= 0, got " << parallel_support << "; ";
   if (!(snap_angle >= 0.0 && snap_angle < 0.5)) err << "snap_angle must be in [0, 0.5) rad, got " << snap_angle << "; ";
   if (region_growing != 0 && region_growing != 1) err << "region_growing must be 0 or 1, got " << region_growing << "; ";
+  if (measurement_threads < 1 || measurement_threads > 8)
+    err << "measurement_threads must be in [1, 8], got " << measurement_threads << "; ";
   if (forgetting != 0 && forgetting != 1) err << "forgetting must be 0 (thinning) or 1 (evidence), got " << forgetting << "; ";
   std::string s = err.str();
   if (s.empty()) return true;

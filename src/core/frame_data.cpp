@@ -6,6 +6,13 @@ namespace hough_plane_detector
 void FrameData::measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
                         const DepthNoiseModel& sensor_noise)
 {
+  ThreadTeam calling_thread_only(1);
+  measure(cloud, pose, params, sensor_noise, calling_thread_only);
+}
+
+void FrameData::measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
+                        const DepthNoiseModel& sensor_noise, ThreadTeam& team)
+{
   camera_to_world = pose;
   noise = sensor_noise;
   NormalEstimatorConfig config;
@@ -15,8 +22,8 @@ void FrameData::measure(const CloudView& cloud, const Eigen::Isometry3d& pose, c
   config.max_curvature = params.max_curvature;
   config.noise = noise;
   config.max_window_scale = params.max_window_scale;
-  normals.compute(cloud, camera_to_world, config, samples);
-  describeBlocks(normals, params, noise, blocks);
+  normals.compute(cloud, camera_to_world, config, samples, team);
+  describeBlocks(normals, params, noise, blocks, team);
   block_claim.clear();
 }
 

@@ -78,6 +78,14 @@ constexpr double kMaxThicknessRatio = 0.25;
 void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
                               const NormalEstimatorConfig& config, std::vector<WindowSample>& samples)
 {
+  ThreadTeam calling_thread_only(1);
+  compute(cloud, camera_to_world, config, samples, calling_thread_only);
+}
+
+void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
+                              const NormalEstimatorConfig& config, std::vector<WindowSample>& samples,
+                              ThreadTeam& team)
+{
   samples.clear();
   valid_windows_ = 0;
   // Blocks of at most 8 x 8 pixels carry the moments (the planarity tests downstream work on
@@ -87,7 +95,7 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
   blocks_y_ = cloud.height / s;
   blocks_.assign(static_cast<size_t>(blocks_x_) * blocks_y_, PointMoments());
   if (blocks_x_ == 0 || blocks_y_ == 0) return;
-  accumulateBlocks(cloud, s);
+  accumulateBlocks(cloud, s, team);
 
   const int k = config.window / s;
   const int step = config.stride / s;
@@ -97,12 +105,21 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
   const double min_count = config.min_valid_fraction * config.window * config.window;
   const Eigen::Matrix3d rotation = camera_to_world.linear();
   const Eigen::Vector3d translation = camera_to_world.translation();
-  for (int wy = 0; wy + k <= blocks_y_; wy += step)
+  const int window_rows = blocks_y_ >= k ? (blocks_y_ - k) / step + 1 : 0;
+  // Each row of windows keeps its own samples; joined in row order they come out the same
+  // whichever thread measured which row.
+  std::vector<std::vector<WindowSample>> row_samples(window_rows);
+  std::vector<int> row_valid(window_rows, 0);
+  team.forEach(window_rows, [&](int row, int) {
+    const int wy = row * step;
+    // Filled locally and stored once: neighbouring rows' entries share cache lines.
+    std::vector<WindowSample> measured;
+    int valid = 0;
     for (int wx = 0; wx + k <= blocks_x_; wx += step)
     {
       const double count = windowMoments(wx, wy, wx + k, wy + k).count;
       if (count < min_count) continue;
-      ++valid_windows_;
+      ++valid;
       Eigen::Vector3d normal, mean;
       if (!measureWindow(wx, wy, k, config, normal, mean)) continue;
       if (normal.dot(mean) > 0.0) normal = -normal;  // toward the sensor at the origin
@@ -113,8 +130,16 @@ void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& c
       sample.count = static_cast<int>(count);  // votes count the window's own points
       sample.window_x = wx;
       sample.window_y = wy;
-      samples.push_back(sample);
+      measured.push_back(sample);
     }
+    row_valid[row] = valid;
+    row_samples[row] = std::move(measured);
+  });
+  for (int row = 0; row < window_rows; ++row)
+  {
+    valid_windows_ += row_valid[row];
+    samples.insert(samples.end(), row_samples[row].begin(), row_samples[row].end());
+  }
 }
 
 namespace
@@ -248,21 +273,22 @@ void toMoments(const BlockAccumulator& b, PointMoments& m)
 }
 }  // namespace
 
-void NormalEstimator::accumulateBlocks(const CloudView& cloud, int s)
+void NormalEstimator::accumulateBlocks(const CloudView& cloud, int s, ThreadTeam& team)
 {
-  std::vector<BlockAccumulator> row_blocks(blocks_x_);
-  for (int by = 0; by < blocks_y_; ++by)
-  {
-    startBlockRow(cloud, by, s, row_blocks);
+  // Block rows are independent; each thread sums into its own row buffer.
+  std::vector<std::vector<BlockAccumulator>> row_blocks(team.size(), std::vector<BlockAccumulator>(blocks_x_));
+  team.forEach(blocks_y_, [&](int by, int member) {
+    std::vector<BlockAccumulator>& row = row_blocks[member];
+    startBlockRow(cloud, by, s, row);
 #ifdef __SSE2__
     if (fourPixelsFit(cloud, by, s))
-      for (int bx = 0; bx < blocks_x_; ++bx) accumulateBlockFourPixels(cloud, bx, by, s, row_blocks[bx]);
+      for (int bx = 0; bx < blocks_x_; ++bx) accumulateBlockFourPixels(cloud, bx, by, s, row[bx]);
     else
 #endif
-      for (int v = by * s; v < (by + 1) * s; ++v) accumulatePixelRow(cloud, v, s, row_blocks);
+      for (int v = by * s; v < (by + 1) * s; ++v) accumulatePixelRow(cloud, v, s, row);
     for (int bx = 0; bx < blocks_x_; ++bx)
-      if (row_blocks[bx].n > 0.0f) toMoments(row_blocks[bx], blocks_[static_cast<size_t>(by) * blocks_x_ + bx]);
-  }
+      if (row[bx].n > 0.0f) toMoments(row[bx], blocks_[static_cast<size_t>(by) * blocks_x_ + bx]);
+  });
 }
 
 void NormalEstimator::buildIntegral()

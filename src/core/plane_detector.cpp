@@ -47,6 +47,7 @@ PlaneDetector::PlaneDetector(const DetectorParams& params)
   , voting_(param_, params.blur_kernel_size / 2, params.blur_sigma)
   , peak_search_(param_, params.peak_window / 2)
   , local_(param_.sizeAngle(), param_.sizeAngle(), param_.sizeD())
+  , measurement_team_(std::make_unique<ThreadTeam>(params.measurement_threads))
   , tests_(params_, frame_)
   , fitter_(params_, param_, frame_, tests_)
   , map_(params_, param_, voting_, peak_search_)
@@ -151,7 +152,7 @@ void PlaneDetector::estimateNormals(const CloudView& cloud)
     focal_length_ = intrinsics.fx * 640.0 / cloud.width;
   }
   frame_.measure(cloud, frame_.camera_to_world, params_,
-                 DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_));
+                 DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_), *measurement_team_);
   stats_.windows_valid = frame_.normals.validWindows();
   stats_.samples = static_cast<int>(frame_.samples.size());
 }
@@ -204,6 +205,8 @@ bool PlaneDetector::updateParams(const DetectorParams& params, std::string* erro
   }
   params_ = params;
   voting_.setBlurSigma(params_.blur_sigma);
+  if (measurement_team_->size() != params_.measurement_threads)
+    measurement_team_ = std::make_unique<ThreadTeam>(params_.measurement_threads);
   return true;
 }
 

@@ -47,7 +47,11 @@ struct BlockInfo
   PointMoments weighted_centroid;  // its points moved to their centroid, weighted by fit_weight
 };
 
-// Fills `info` (row-major over the estimator's block grid) from the estimator's last frame.
+// Fills `info` (row-major over the estimator's block grid) from the estimator's last frame,
+// its rows of blocks shared out over `team` (each block is described on its own).
+void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
+                    std::vector<BlockInfo>& info, ThreadTeam& team);
+// The same on the calling thread alone.
 void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
                     std::vector<BlockInfo>& info);
 

@@ -34,7 +34,8 @@
   X(int, parallel_support)             \
   X(double, snap_angle)                \
   X(int, region_growing)               \
-  X(int, forgetting)
+  X(int, forgetting)                   \
+  X(int, measurement_threads)
 
 namespace hough_plane_detector
 {
@@ -127,6 +128,9 @@ struct DetectorParams
   // extent the frames show to be gone leaves within about ten frames; core/plane_evidence.h),
   // 0 = thinning (paper 3.7: every cell loses thinning_rate per frame; Fig. 6-8 use it).
   int forgetting = 1;
+  // Threads that measure a frame's blocks and windows (the calling one and measurement_threads - 1
+  // helpers, 1 to 8); the planes found do not depend on it.
+  int measurement_threads = 2;
 
   // True when the combination is valid; otherwise false, with what is wrong in `error`.
   bool validate(std::string* error = nullptr) const;

@@ -30,6 +30,9 @@ struct FrameData
   // the parameters' window, stride and planarity limits.
   void measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
                const DepthNoiseModel& sensor_noise);
+  // The same with blocks and windows shared out over `team`'s threads (same result).
+  void measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
+               const DepthNoiseModel& sensor_noise, ThreadTeam& team);
 
   int blocksX() const { return normals.blocksX(); }
   int blocksY() const { return normals.blocksY(); }

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "hough_plane_detector/core/cloud_view.h"
+#include "hough_plane_detector/core/thread_team.h"
 #include "hough_plane_detector/core/sensor_model.h"
 
 namespace hough_plane_detector
@@ -74,6 +75,11 @@ class NormalEstimator
 {
 public:
   // Fills `samples` with one sample per planar window of the cloud, transformed to the world.
+  // Block rows and window rows are shared out over `team`; the result does not depend on
+  // its size.
+  void compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, const NormalEstimatorConfig& config,
+               std::vector<WindowSample>& samples, ThreadTeam& team);
+  // The same on the calling thread alone.
   void compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, const NormalEstimatorConfig& config,
                std::vector<WindowSample>& samples);
 
@@ -86,7 +92,7 @@ public:
 
 private:
   // Point moments of every s x s pixel block.
-  void accumulateBlocks(const CloudView& cloud, int s);
+  void accumulateBlocks(const CloudView& cloud, int s, ThreadTeam& team);
   // The summed-area table over the blocks (when windows span several blocks).
   void buildIntegral();
   // Moments of the blocks [x0, x1) x [y0, y1), clipped to the grid.

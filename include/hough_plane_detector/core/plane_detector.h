@@ -31,6 +31,7 @@
 #include "hough_plane_detector/core/hough_voting.h"
 #include "hough_plane_detector/core/planarity_tests.h"
 #include "hough_plane_detector/core/plane_map.h"
+#include "hough_plane_detector/core/thread_team.h"
 #include "hough_plane_detector/core/sparse_hough_space.h"
 
 namespace hough_plane_detector
@@ -152,6 +153,7 @@ private:
   HoughPeakSearch peak_search_;
   SparseHoughSpace local_;
   FrameData frame_;
+  std::unique_ptr<ThreadTeam> measurement_team_;  // measurement_threads members
   PlanarityTests tests_;
   FramePlaneFitter fitter_;
   PlaneMap map_;
