@@ -57,6 +57,7 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
       i.valid = block.count >= 3;
       if (!i.valid) continue;
       i.centroid = block.mean();
+      i.ray = i.centroid.normalized();
       i.covariance = block.covariance();
       const double sigma = noise.sigma(i.centroid.z());
       const double step = noise.quantizationStep(i.centroid.z());
@@ -109,15 +110,16 @@ bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double
 {
   const BlockInfo& i = info_[block];
   if (!i.planar) return false;
+  // The distance first: it turns away most blocks of a frame (seedComponents asks them all).
+  // A face's warp adds to the block's noise as an independent error.
+  const double reach = warp > 0.0 ? std::sqrt(i.region_residual * i.region_residual + warp * warp) : i.region_residual;
+  if (!(std::abs(normal.dot(i.centroid) + d) <= std::min(params_.support_distance, reach))) return false;
   // A thick block at a fold would pass any normal; where that matters only oriented ones join.
   if (oriented_only && i.normal_tolerance >= M_PI / 2) return false;
   if (std::abs(i.normal.dot(normal)) < i.normal_tolerance_cosine) return false;
   // Rays that graze a plane move along it with their depth error, so any surface they hit
   // lies "on" it: a plane seen edge-on cannot be tested, and no block joins it that way.
-  if (std::abs(normal.dot(i.centroid.normalized())) < kMinRaySine) return false;
-  // A face's warp adds to the block's noise as an independent error.
-  const double reach = warp > 0.0 ? std::sqrt(i.region_residual * i.region_residual + warp * warp) : i.region_residual;
-  return std::abs(normal.dot(i.centroid) + d) <= std::min(params_.support_distance, reach);
+  return !(std::abs(normal.dot(i.ray)) < kMinRaySine);
 }
 
 size_t BlockRegionGrower::sweep(std::vector<int>& blocks, const std::vector<char>& taken, const Eigen::Vector3d& normal,
@@ -154,7 +156,7 @@ bool BlockRegionGrower::wholeFacePlane(const PlaneRegion& region, const std::vec
 bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
 {
   size_t grazing = 0;
-  for (int b : blocks) grazing += std::abs(normal.dot(info_[b].centroid.normalized())) < kMinRaySine;
+  for (int b : blocks) grazing += std::abs(normal.dot(info_[b].ray)) < kMinRaySine;
   return 2 * grazing > blocks.size();
 }
 

@@ -15,13 +15,6 @@
 namespace hough_plane_detector
 {
 
-void PointMoments::scale(double w)
-{
-  count *= w;
-  sum *= w;
-  xx *= w; xy *= w; xz *= w; yy *= w; yz *= w; zz *= w;
-}
-
 Eigen::Matrix3d PointMoments::covariance() const
 {
   const Eigen::Vector3d m = mean();

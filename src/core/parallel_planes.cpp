@@ -79,7 +79,7 @@ private:
       // is as thin along the normal as a floor's: there the thickness test means nothing.
       if (info.centroid_variance > kMaxParallelCentroidSigma * kMaxParallelCentroidSigma * params_.support_distance *
                                        params_.support_distance ||
-          std::abs(n_cam_.dot(info.centroid.normalized())) < kMinParallelGrazingSine)
+          std::abs(n_cam_.dot(info.ray)) < kMinParallelGrazingSine)
         continue;
       offsets_.emplace_back(-n_cam_.dot(info.centroid) - shift_, b);
     }

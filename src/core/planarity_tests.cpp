@@ -42,14 +42,21 @@ bool PlanarityTests::isPlanarFit(const PointMoments& moments, const std::vector<
 bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const
 {
   // A curved strip fits a plane within the noise, but its two halves tilt apart.
-  const int bx_count = frame_.normals.blocksX();
-  PointMoments all;
-  std::vector<PointMoments> centroids;  // each block's, for both axes
+  // Each block's centroid moments, centroid and variance, read once for both axes.
+  struct Centroid
+  {
+    PointMoments moments;
+    Eigen::Vector3d position;
+    double variance;
+  };
+  std::vector<Centroid> centroids;
   centroids.reserve(end - begin);
+  PointMoments all;
   for (size_t i = begin; i < end; ++i)
   {
-    centroids.push_back(centroidMoments(frame_.normals.block(blocks[i] % bx_count, blocks[i] / bx_count)));
-    all.add(centroids.back());
+    const PointMoments moments = centroidMoments(frame_.moments(blocks[i]));
+    centroids.push_back({moments, moments.mean(), frame_.blocks[blocks[i]].centroid_variance + kCentroidFloor});
+    all.add(moments);
   }
   if (all.count < 3) return true;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -61,12 +68,11 @@ bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, s
     PointMoments halves[2];
     double half_variance[2] = {0.0, 0.0};  // mean centroid variance of each half's blocks
     int half_blocks[2] = {0, 0};
-    for (size_t i = begin; i < end; ++i)
+    for (const Centroid& centroid : centroids)
     {
-      const PointMoments& block = centroids[i - begin];
-      const int h = direction.dot(block.mean() - mean) >= 0.0 ? 1 : 0;
-      halves[h].add(block);
-      half_variance[h] += frame_.blocks[blocks[i]].centroid_variance + kCentroidFloor;
+      const int h = direction.dot(centroid.position - mean) >= 0.0 ? 1 : 0;
+      halves[h].add(centroid.moments);
+      half_variance[h] += centroid.variance;
       ++half_blocks[h];
     }
     for (int h = 0; h < 2; ++h)

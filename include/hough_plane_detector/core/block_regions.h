@@ -35,6 +35,7 @@ struct BlockInfo
   bool valid = false;       // at least 3 points
   bool planar = false;      // its spread along its normal is the sensor's noise, not an edge
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Vector3d ray = Eigen::Vector3d::UnitZ();  // unit direction from the sensor to the centroid
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // of its own points, toward the sensor
   double normal_tolerance = 0;   // largest angle to a region's normal its noise explains (rad)

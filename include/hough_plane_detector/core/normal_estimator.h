@@ -35,7 +35,12 @@ struct PointMoments
     xx -= o.xx; xy -= o.xy; xz -= o.xz; yy -= o.yy; yz -= o.yz; zz -= o.zz;
   }
   // Weights every point by w (mean and covariance unchanged, count becomes a weight sum).
-  void scale(double w);
+  void scale(double w)
+  {
+    count *= w;
+    sum *= w;
+    xx *= w; xy *= w; xz *= w; yy *= w; yz *= w; zz *= w;
+  }
   Eigen::Vector3d mean() const { return sum / count; }
   Eigen::Matrix3d covariance() const;
   // The normal of their least-squares plane (unit, either sign); false when they lie along a
