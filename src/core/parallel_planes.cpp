@@ -65,7 +65,7 @@ public:
   }
 
 private:
-  double points(size_t i) const { return used_[i] ? 0.0 : frame_.points(offsets_[i].second); }
+  double points(size_t i) const { return used_[i] ? 0.0 : offset_points_[i]; }
 
   void collectOffsets()
   {
@@ -73,7 +73,7 @@ private:
     for (int b = 0; b < static_cast<int>(frame_.blocks.size()); ++b)
     {
       const BlockInfo& info = frame_.blocks[b];
-      if (!info.valid || frame_.block_claim[b] || n_cam_.dot(info.covariance * n_cam_) > info.thickness_limit) continue;
+      if (!info.valid || frame_.block_claim[b]) continue;
       // A block says which side of its neighbours it lies on only if its centroid is much more
       // precise than the cluster width; and seen along the plane (grazing rays), a wall's block
       // is as thin along the normal as a floor's: there the thickness test means nothing.
@@ -81,10 +81,13 @@ private:
                                        params_.support_distance ||
           std::abs(n_cam_.dot(info.ray)) < kMinParallelGrazingSine)
         continue;
+      if (n_cam_.dot(info.covariance * n_cam_) > info.thickness_limit) continue;
       offsets_.emplace_back(-n_cam_.dot(info.centroid) - shift_, b);
     }
     std::sort(offsets_.begin(), offsets_.end());
     used_.assign(offsets_.size(), 0);
+    offset_points_.resize(offsets_.size());
+    for (size_t i = 0; i < offsets_.size(); ++i) offset_points_[i] = frame_.points(offsets_[i].second);
   }
 
   // The densest interval of support_distance in d, by points, its offset at the mode; false
@@ -224,6 +227,7 @@ private:
   double shift_ = 0.0;
   std::vector<std::pair<double, int>> offsets_;  // world d of each flat free block, sorted
   std::vector<char> used_;
+  std::vector<double> offset_points_;  // points of each entry of offsets_, read once
   std::vector<int> blocks_;
 };
 }  // namespace
