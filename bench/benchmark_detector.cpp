@@ -168,9 +168,8 @@ void benchVariants(const std::vector<RenderedFrame>& rendered)
       }
     return median(total);
   };
-  DetectorParams windows, evidence, thinning, one_thread;
+  DetectorParams windows, evidence, thinning;
   windows.region_growing = 0;
-  one_thread.measurement_threads = 1;
   evidence.forgetting = kForgetByEvidence;
   thinning.forgetting = kForgetByThinning;
   std::vector<double> evidence_ms;
@@ -181,8 +180,24 @@ void benchVariants(const std::vector<RenderedFrame>& rendered)
   std::printf("  forgetting 1 (by evidence, the default): total %6.3f ms, of which the evidence check %.3f ms (p90 %.3f)\n",
               evidence_total, median(evidence_ms), percentile(evidence_ms, 0.9));
   std::printf("  forgetting 0 (the paper's thinning): total %6.3f ms\n", thinning_total);
-  std::printf("  measurement_threads 1 (all on one core): total %6.3f ms (default %d)\n", variantMedians(one_thread, nullptr),
-              DetectorParams().measurement_threads);
+  // One thread against two, frame by frame in turn: this VM's speed drifts between runs.
+  DetectorParams one_thread, two_threads;
+  one_thread.measurement_threads = 1;
+  two_threads.measurement_threads = 2;
+  PlaneDetector alone(one_thread), pair(two_threads);
+  std::vector<double> alone_normals, alone_total, pair_normals, pair_total;
+  for (int lap = 0; lap < 2; ++lap)
+    for (int f = 0; f < frames; ++f)
+    {
+      alone.processFrame(rendered[f].view(), rendered[f].camera_to_world, lap * frames + f);
+      pair.processFrame(rendered[f].view(), rendered[f].camera_to_world, lap * frames + f);
+      alone_normals.push_back(alone.lastTimings().normals_ms);
+      alone_total.push_back(alone.lastTimings().total_ms);
+      pair_normals.push_back(pair.lastTimings().normals_ms);
+      pair_total.push_back(pair.lastTimings().total_ms);
+    }
+  std::printf("  measurement_threads 1 / 2, in turn: normals %.3f / %.3f ms, total %.3f / %.3f ms\n", median(alone_normals),
+              median(pair_normals), median(alone_total), median(pair_total));
   std::vector<double> intrinsics_ms;
   for (int f = 0; f < frames; ++f)
   {
