@@ -51,7 +51,7 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
   team.forEach(grid.blocksY(), [&](int by, int) {
     for (int b = by * bx_count; b < (by + 1) * bx_count; ++b)
     {
-      const PointMoments& block = grid.block(b % bx_count, b / bx_count);
+      const PointMoments& block = grid.block(b - by * bx_count, by);
       BlockInfo& i = info[b];
       i = BlockInfo();
       i.valid = block.count >= 3;
@@ -91,13 +91,6 @@ void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, c
       i.normal_tolerance_cosine = std::cos(i.normal_tolerance);
     }
   });
-}
-
-void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
-                    std::vector<BlockInfo>& info)
-{
-  ThreadTeam calling_thread_only(1);
-  describeBlocks(grid, params, noise, info, calling_thread_only);
 }
 
 BlockRegionGrower::BlockRegionGrower(const NormalEstimator& grid, const std::vector<BlockInfo>& info,

@@ -4,13 +4,6 @@ namespace hough_plane_detector
 {
 
 void FrameData::measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
-                        const DepthNoiseModel& sensor_noise)
-{
-  ThreadTeam calling_thread_only(1);
-  measure(cloud, pose, params, sensor_noise, calling_thread_only);
-}
-
-void FrameData::measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
                         const DepthNoiseModel& sensor_noise, ThreadTeam& team)
 {
   camera_to_world = pose;

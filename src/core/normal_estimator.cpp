@@ -69,13 +69,6 @@ constexpr double kMaxThicknessRatio = 0.25;
 }  // namespace
 
 void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
-                              const NormalEstimatorConfig& config, std::vector<WindowSample>& samples)
-{
-  ThreadTeam calling_thread_only(1);
-  compute(cloud, camera_to_world, config, samples, calling_thread_only);
-}
-
-void NormalEstimator::compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
                               const NormalEstimatorConfig& config, std::vector<WindowSample>& samples,
                               ThreadTeam& team)
 {

@@ -10,6 +10,12 @@ ThreadTeam::ThreadTeam(int members) : members_(std::max(1, members))
   for (int member = 1; member < members_; ++member) helpers_.emplace_back([this, member] { helperLoop(member); });
 }
 
+ThreadTeam& ThreadTeam::callingThreadOnly()
+{
+  static ThreadTeam alone(1);
+  return alone;
+}
+
 ThreadTeam::~ThreadTeam()
 {
   {

@@ -51,10 +51,7 @@ struct BlockInfo
 // Fills `info` (row-major over the estimator's block grid) from the estimator's last frame,
 // its rows of blocks shared out over `team` (each block is described on its own).
 void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
-                    std::vector<BlockInfo>& info, ThreadTeam& team);
-// The same on the calling thread alone.
-void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
-                    std::vector<BlockInfo>& info);
+                    std::vector<BlockInfo>& info, ThreadTeam& team = ThreadTeam::callingThreadOnly());
 
 // Calls visit(neighbour) for each 4-neighbour of block b inside a bx_count x by_count grid.
 template <class Visit>

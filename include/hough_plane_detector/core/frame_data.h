@@ -28,11 +28,9 @@ struct FrameData
 
   // Measures a cloud: windows' normals, blocks and their noise statistics, with `noise` and
   // the parameters' window, stride and planarity limits.
+  // Blocks and windows are shared out over `team`'s threads (the same result for any number).
   void measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
-               const DepthNoiseModel& sensor_noise);
-  // The same with blocks and windows shared out over `team`'s threads (same result).
-  void measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
-               const DepthNoiseModel& sensor_noise, ThreadTeam& team);
+               const DepthNoiseModel& sensor_noise, ThreadTeam& team = ThreadTeam::callingThreadOnly());
 
   int blocksX() const { return normals.blocksX(); }
   int blocksY() const { return normals.blocksY(); }

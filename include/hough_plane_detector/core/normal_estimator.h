@@ -83,10 +83,7 @@ public:
   // Block rows and window rows are shared out over `team`; the result does not depend on
   // its size.
   void compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, const NormalEstimatorConfig& config,
-               std::vector<WindowSample>& samples, ThreadTeam& team);
-  // The same on the calling thread alone.
-  void compute(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world, const NormalEstimatorConfig& config,
-               std::vector<WindowSample>& samples);
+               std::vector<WindowSample>& samples, ThreadTeam& team = ThreadTeam::callingThreadOnly());
 
   // Camera-frame moments of the block grid (blockSize() pixel blocks) of the last cloud.
   int blocksX() const { return blocks_x_; }

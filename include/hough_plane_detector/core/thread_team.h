@@ -24,6 +24,9 @@ public:
   ThreadTeam(const ThreadTeam&) = delete;
   ThreadTeam& operator=(const ThreadTeam&) = delete;
 
+  // A team of the calling thread alone, shared: with no helpers it keeps no state across calls.
+  static ThreadTeam& callingThreadOnly();
+
   int size() const { return members_; }
   // Calls work once for every index in [0, n) and returns when all are done. Members take the
   // next index as they come free (rows of unequal cost stay balanced); a caller that keeps each
