@@ -176,6 +176,25 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
       }
     OsdFitError fit{frame, e.name, e.points, labelled};
     matches(best->normal, best->d, e, &fit.angle);
+    const FramePlane* fitted = nullptr;
+    double fitted_angle = kMatchAngle;
+    for (const FramePlane& p : detector.lastFramePlanes())
+      if (unsignedAngle(p.normal, best->normal) <= fitted_angle && std::abs(p.d - best->d) <= kMatchDistance)
+      {
+        fitted_angle = unsignedAngle(p.normal, best->normal);
+        fitted = &p;
+      }
+    if (fitted && fitted->parallel && !fitted->own_normal.isZero())
+    {
+      fit.snapped = true;
+      fit.own_angle = unsignedAngle(fitted->own_normal, e.normal);
+      const Eigen::Vector3d n = fitted->own_normal.normalized();
+      // The information's smallest eigenvalue across the normal: the loosest direction.
+      const Eigen::Matrix3d across = (Eigen::Matrix3d::Identity() - n * n.transpose()) * fitted->own_normal_information *
+                                     (Eigen::Matrix3d::Identity() - n * n.transpose());
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> info(across);
+      fit.own_sigma = info.eigenvalues()(1) > 0.0 ? 1.0 / std::sqrt(info.eigenvalues()(1)) : 0.0;
+    }
     fit.labelled_fit_angle = M_PI / 2;
     if (labelled >= 3)
     {
@@ -395,14 +414,16 @@ std::string osdFitErrorsMarkdown(const OsdResults& results)
   std::vector<OsdFitError> sorted = results.fit_errors;
   std::sort(sorted.begin(), sorted.end(), [](const OsdFitError& a, const OsdFitError& b) { return a.angle > b.angle; });
   std::string md = "| frame | entry | points | E_angle ours (rad) | E_angle of the LSQ plane of our labelled pixels | "
-                   "those pixels |\n|---|---|---|---|---|---|\n";
+                   "those pixels | snapped: E_angle of its own normal, that normal's sigma |\n|---|---|---|---|---|---|---|\n";
   char line[256];
   for (const OsdFitError& f : sorted)
   {
     char own[32] = "-";  // the matching plane labels no pixel near the face
     if (f.labelled >= 3) std::snprintf(own, sizeof(own), "%.4f", f.labelled_fit_angle);
-    std::snprintf(line, sizeof(line), "| %s | %s | %d | %.4f | %s | %d |\n", f.frame.c_str(), f.entry.c_str(), f.points,
-                  f.angle, own, f.labelled);
+    char snap[48] = "-";
+    if (f.snapped) std::snprintf(snap, sizeof(snap), "%.4f, %.4f", f.own_angle, f.own_sigma);
+    std::snprintf(line, sizeof(line), "| %s | %s | %d | %.4f | %s | %d | %s |\n", f.frame.c_str(), f.entry.c_str(),
+                  f.points, f.angle, own, f.labelled, snap);
     md += line;
   }
   return md;

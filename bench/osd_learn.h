@@ -47,6 +47,10 @@ struct OsdFitError
   int labelled = 0;                // our labelled pixels the second fit used
   double angle = 0.0;              // ours against the annotation (rad)
   double labelled_fit_angle = 0.0;  // least squares of our labelled pixels against the annotation
+  // This frame's fit of the face (the frame plane nearest the map plane): snapped to a known
+  // normal, and then the error of the normal its own blocks fit and that normal's sigma.
+  bool snapped = false;
+  double own_angle = 0.0, own_sigma = 0.0;
 };
 
 struct OsdResults
