@@ -5,7 +5,7 @@
 // same scoring as make evaluate (PCL's methods left out). The held-out seeds are not here on
 // purpose: their figures come from make evaluate only, after a change is decided.
 // With --osd, the annotated real frames of osd-learn too (one frame each, PCL left out).
-// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--PARAM VALUE ...] (see --help)
+// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--list] [--PARAM VALUE ...] (see --help)
 #include <cstdio>
 #include <functional>
 #include <future>
@@ -37,13 +37,45 @@ struct SetResult
   std::string name;
   MethodStats stats;
   std::map<std::string, int> causes;  // our misses by cause
+  std::vector<std::string> listed;  // one line per false or missed plane of a scored frame
 };
+
+// A false plane: where, what, and the true plane nearest it (hidden ones too).
+std::string describeFalsePlane(const std::string& where, int frame, const PlaneDetector& detector,
+                               const DetectedPlane& plane, const std::vector<TruePlane>& truth)
+{
+  double best_cost = 1e9, best_angle = 0.0, best_distance = 0.0;
+  for (const TruePlane& t : truth)
+  {
+    const double angle = angleError(plane.normal, t.normal), distance = distanceError(plane.normal, plane.d, t.normal, t.d);
+    const MatchTolerance tolerance;
+    if (angle / tolerance.angle + distance / tolerance.distance < best_cost)
+    {
+      best_cost = angle / tolerance.angle + distance / tolerance.distance;
+      best_angle = angle;
+      best_distance = distance;
+    }
+  }
+  // This frame's fit of it, if any: snapped (parallel) or not.
+  const char* fitted = "not fitted this frame";
+  for (const FramePlane& f : detector.lastFramePlanes())
+    if (angleError(f.normal, plane.normal) < 0.02 && distanceError(f.normal, f.d, plane.normal, plane.d) < 0.03)
+      fitted = f.parallel ? "snapped or parallel search" : "own fit";
+  char line[400];
+  std::snprintf(line, sizeof(line),
+                "%s frame %2d: id %d n (%+.3f %+.3f %+.3f) d %+.3f support %d, seen %.1f s, depths confirmed it "
+                "%lld / contradicted it %lld frames; nearest true plane %.3f rad, %.3f m off; this frame: %s",
+                where.c_str(), frame, plane.id, plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.d,
+                plane.support, plane.last_seen - plane.first_seen, static_cast<long long>(plane.confirmations),
+                static_cast<long long>(plane.contradictions), best_angle, best_distance, fitted);
+  return line;
+}
 
 using ParamsFor = std::function<DetectorParams(double noise)>;
 
 // One camera path through one scene: scored from kWarmupFrames on every stride-th frame.
-void runSequence(const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, double noise, uint32_t noise_seed,
-                 int stride, const DetectorParams& params, SetResult& result)
+void runSequence(const std::string& where, const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, double noise,
+                 uint32_t noise_seed, int stride, const DetectorParams& params, SetResult& result)
 {
   const SceneRenderer renderer(scene);
   PlaneDetector detector(params);
@@ -57,7 +89,17 @@ void runSequence(const Scene& scene, const std::vector<Eigen::Isometry3d>& poses
     const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
                                                evaluatedPlanes(detector.planes()));
     result.stats.add(metrics);
-    for (int missed : metrics.missed) ++result.causes[missCause(detector, renderer.truePlanes()[missed])];
+    for (int k : metrics.false_indices)
+      result.listed.push_back("false: " +
+          describeFalsePlane(where, static_cast<int>(f), detector, detector.planes()[k], renderer.truePlanes()));
+    for (int missed : metrics.missed)
+    {
+      const TruePlane& truth = renderer.truePlanes()[missed];
+      const std::string cause = missCause(detector, truth);
+      ++result.causes[cause];
+      result.listed.push_back("missed: " + where + " frame " + std::to_string(f) + ": " + truth.name + " (" +
+                              std::to_string(frame.visible_points[missed]) + " points): " + cause);
+    }
   }
 }
 
@@ -71,7 +113,8 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
     RandomScene room = makeRandomScene(seed, kRoomFrames);
     if (noise_override > 0.0) room.noise = noise_override;
     // The room's own noise seeds, as make evaluate renders them.
-    runSequence(room.scene, room.poses, room.noise, seed * 1000, 3, params_for(room.noise), result);
+    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000, 3,
+                params_for(room.noise), result);
   }
   return result;
 }
@@ -80,7 +123,7 @@ SetResult runTableThree(const ParamsFor& params_for)
 {
   SetResult result{"Table 3's tours", {}, {}};
   for (const NamedScene& named : tableThreeScenes())
-    runSequence(named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, 3, params_for(1.0), result);
+    runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, 3, params_for(1.0), result);
   return result;
 }
 
@@ -89,8 +132,8 @@ SetResult runOtherTours(const ParamsFor& params_for)
   SetResult result{"Table 3's scenes, other tours", {}, {}};
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
-      runSequence(named.scene, roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, 3, params_for(1.0),
-                  result);
+      runSequence(std::string(named.name) + ", " + tour.name, named.scene,
+                  roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, 3, params_for(1.0), result);
   return result;
 }
 
@@ -100,15 +143,18 @@ SetResult runFigureSeven(const ParamsFor& params_for)
   SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}};
   DetectorParams params = params_for(4.0);
   params.forgetting = kForgetByThinning;
-  runSequence(makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kFigureSevenStride, params, result);
+  runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kFigureSevenStride, params,
+              result);
   return result;
 }
 
-void print(const SetResult& r, bool causes)
+void print(const SetResult& r, bool causes, bool list)
 {
   std::printf("%-32s %5.1f %% (%d/%d)  false/frame %.3f  E_angle %.4f  E_d %.4f  frames %d\n", r.name.c_str(),
               r.stats.detectionPercent(), r.stats.detected, r.stats.visible, r.stats.falsePerFrame(), mean(r.stats.angle),
               mean(r.stats.d), r.stats.frames);
+  if (list)
+    for (const std::string& line : r.listed) std::printf("    %s\n", line.c_str());
   if (!causes) return;
   for (const auto& cause : r.causes) std::printf("    %4d  %s\n", cause.second, cause.first.c_str());
 }
@@ -125,7 +171,8 @@ int main(int argc, char** argv)
        "comma-separated: tuning (seeds 901-908), development (950-965), development-c1 (the same at C = 1), "
        "development-b (300-339 at C = 1), table3, other, fig7 (default: all)")
       ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
-      ("causes", "our misses of each set by what became of their candidate");
+      ("causes", "our misses of each set by what became of their candidate")
+      ("list", "every false plane of a scored frame (with the true plane nearest it) and every missed one (with its cause)");
   addDetectorParamOptions(scratch, detector_options, hidden);
   po::options_description all;
   all.add(options).add(detector_options).add(hidden);
@@ -143,7 +190,8 @@ int main(int argc, char** argv)
   }
   std::vector<std::pair<std::string, std::string>> overrides;
   for (const auto& value : values)
-    if (value.first != "sets" && value.first != "causes" && value.first != "help" && value.first != "osd")
+    if (value.first != "sets" && value.first != "causes" && value.first != "list" && value.first != "help" &&
+        value.first != "osd")
       overrides.emplace_back(value.first, value.second.as<std::string>());
   // Each room's sensor_noise as make evaluate sets it, then the flags given.
   const ParamsFor params_for = [&overrides](double noise) {
@@ -185,7 +233,8 @@ int main(int argc, char** argv)
   std::vector<std::future<SetResult>> results;
   for (const auto& run : runs) results.push_back(std::async(std::launch::async, run));
   const bool causes = values.count("causes") > 0;
-  for (auto& result : results) print(result.get(), causes);
+  const bool list_planes = values.count("list") > 0;
+  for (auto& result : results) print(result.get(), causes, list_planes);
   if (osd_dir.empty()) return 0;
   OsdResults osd;
   if (!evaluateOsdLearn(osd_dir, params_for(0.0), false, false, "", osd, &error))

@@ -32,6 +32,8 @@ TEST(PlaneMetrics, CountsMissesFalseAndDuplicateDetections)
   EXPECT_EQ(m.detected, 1);
   EXPECT_NEAR(m.missRate(), 0.5, 1e-12);
   EXPECT_EQ(m.false_detections, 2);
+  EXPECT_EQ(m.false_indices, (std::vector<int>{1, 3}));  // the duplicate and the empty place
+  EXPECT_EQ(m.missed, (std::vector<int>{1}));
   ASSERT_EQ(m.d_errors.size(), 1u);
   EXPECT_NEAR(m.d_errors[0], 0.004, 1e-9);
   EXPECT_NEAR(m.angle_errors[0], 0.0, 1e-9);

@@ -82,8 +82,12 @@ FrameMetrics evaluateFrame(const std::vector<TruePlane>& true_planes, const std:
     m.angle_errors.push_back(angleError(det.normal, true_planes[t].normal));
     m.d_errors.push_back(distanceError(det.normal, det.d, true_planes[t].normal, true_planes[t].d));
   }
-  for (int match : detection_match)
-    if (match < 0) ++m.false_detections;
+  for (size_t k = 0; k < detections.size(); ++k)
+    if (detection_match[k] < 0)
+    {
+      ++m.false_detections;
+      m.false_indices.push_back(static_cast<int>(k));
+    }
   return m;
 }
 

@@ -31,6 +31,7 @@ struct FrameMetrics
   int visible = 0;               // |P|: true planes with enough visible points
   int detected = 0;              // of those, matched by a detection
   int false_detections = 0;      // detections that match no true plane of the scene
+  std::vector<int> false_indices;  // ... their indices in the detections
   std::vector<double> angle_errors;  // E_angle per matched visible plane (eq. 12)
   std::vector<double> d_errors;      // E_d per matched visible plane (eq. 13)
   std::vector<int> missed;           // indices of the visible true planes no detection matched
