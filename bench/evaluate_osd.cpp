@@ -1,5 +1,5 @@
 // The osd-learn section of make evaluate on its own, for quick checks while changing the
-// detector: evaluate_osd DIR [--no-pcl] [--misses] [--errors] [--pictures OUT_DIR] [--PARAM VALUE ...]
+// detector: evaluate_osd DIR [--no-pcl] [--misses] [--errors] [--noise] [--pictures OUT_DIR] [--PARAM VALUE ...]
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -19,6 +19,7 @@ int main(int argc, char** argv)
       ("no-pcl", "skip PCL RANSAC and OMPS")
       ("misses", "list every missed entry with what became of its candidate")
       ("errors", "list every found entry's normal error beside that of the least-squares plane of our labelled pixels")
+      ("noise", "the sensor's noise on the table's blocks against the detector's noise model")
       ("pictures", po::value(&picture_dir)->value_name("OUT_DIR"), "write segmented pictures of a few frames there");
   addDetectorParamOptions(params, detector_options, hidden);
   hidden.add_options()("dir", po::value(&dir));
@@ -51,5 +52,6 @@ int main(int argc, char** argv)
   if (!misses) md = md.substr(0, md.find("| frame | entry"));
   std::cout << md;
   if (errors) std::cout << "\n" << osdFitErrorsMarkdown(results);
+  if (values.count("noise")) std::cout << "\n" << osdNoiseMarkdown(results);
   return 0;
 }

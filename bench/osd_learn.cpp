@@ -206,6 +206,27 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
   }
 }
 
+// The table's blocks (within 1 cm of its annotated plane, 32 points or more) against the
+// detector's noise model: see OsdResults.
+void tableNoise(const PlaneDetector& detector, const std::vector<Entry>& entries, OsdResults& results)
+{
+  const FrameData& frame = detector.lastFrame();
+  for (const Entry& e : entries)
+  {
+    if (e.name != "table") continue;
+    for (size_t b = 0; b < frame.blocks.size(); ++b)
+    {
+      const BlockInfo& info = frame.blocks[b];
+      if (!info.valid || frame.points(static_cast<int>(b)) < 32) continue;
+      const double offset = e.normal.dot(info.centroid) + e.d;
+      if (std::abs(offset) > 0.01) continue;
+      const double sigma = frame.noise.sigma(info.centroid.z());
+      results.table_block_spread.push_back(e.normal.dot(info.covariance * e.normal) / (sigma * sigma));
+      results.table_centroid_chi2.push_back(offset * offset / info.centroid_variance);
+    }
+  }
+}
+
 // Objects of a curved-object frame with no annotated face: cans and mugs.
 std::set<uint32_t> curvedObjects(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<Entry>& entries)
 {
@@ -340,6 +361,7 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
           results.misses.push_back(miss);
         }
       if (with_fit_errors) fitErrors(detector, view, cloud, name, entries, found, results.fit_errors);
+      tableNoise(detector, entries, results);
       if (index >= kFirstCurvedFrame)
         single.curved_planes += planesOnCurvedObjects(detector, view, cloud, curvedObjects(cloud, entries));
       if (!picture_dir.empty() && picture_frames.count(name))
@@ -407,6 +429,22 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
   }
   md += "\n\n";
   return md;
+}
+
+std::string osdNoiseMarkdown(const OsdResults& results)
+{
+  auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "Noise on the table's %zu blocks against the model: spread along the normal / sigma^2 median %.3f "
+                "(1 as modelled); centroid offset^2 / centroid variance median %.3f (0.455 as modelled)\n",
+                results.table_block_spread.size(), median(results.table_block_spread),
+                median(results.table_centroid_chi2));
+  return line;
 }
 
 std::string osdFitErrorsMarkdown(const OsdResults& results)
