@@ -31,6 +31,7 @@ constexpr int kRoomFrames = 30;   // as make evaluate's procedural rooms
 constexpr int kTableThreeFrames = 60;
 constexpr int kFigureSevenFrames = 48;
 constexpr int kFigureSevenStride = 4;
+double noise_correlation_px = 0.0;  // --noise-correlation: the renderer's correlated noise (KinectNoise)
 
 struct SetResult
 {
@@ -81,6 +82,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
   PlaneDetector detector(params);
   KinectNoise kinect;
   kinect.coefficient = noise;
+  kinect.correlation_px = noise_correlation_px;
   for (size_t f = 0; f < poses.size(); ++f)
   {
     const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
@@ -172,6 +174,9 @@ int main(int argc, char** argv)
        "development-b (300-339 at C = 1), table3, other, fig7 (default: all)")
       ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
       ("causes", "our misses of each set by what became of their candidate")
+      ("noise-correlation", po::value(&noise_correlation_px)->value_name("PX"),
+       "render spatially correlated noise, a field smoothed over PX pixels (real frames' structure; default 0: "
+       "independent per pixel, as make evaluate renders)")
       ("list", "every false plane of a scored frame (with the true plane nearest it) and every missed one (with its cause)");
   addDetectorParamOptions(scratch, detector_options, hidden);
   po::options_description all;
@@ -190,7 +195,7 @@ int main(int argc, char** argv)
   }
   std::vector<std::pair<std::string, std::string>> overrides;
   for (const auto& value : values)
-    if (value.first != "sets" && value.first != "causes" && value.first != "list" && value.first != "help" &&
+    if (value.first != "sets" && value.first != "causes" && value.first != "list" && value.first != "noise-correlation" && value.first != "help" &&
         value.first != "osd")
       overrides.emplace_back(value.first, value.second.as<std::string>());
   // Each room's sensor_noise as make evaluate sets it, then the flags given.

@@ -2,6 +2,7 @@
 
 #include "hough_plane_detector/core/sensor_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -88,6 +89,49 @@ SceneRenderer::SceneRenderer(const Scene& scene, const CameraIntrinsics& intrins
   true_planes_ = scene_.truePlanes(&rectangle_plane_);
 }
 
+namespace
+{
+// Unit-variance noise field: a Gaussian-smoothed white field (separable, renormalized) mixed
+// with an independent share of the variance.
+std::vector<float> correlatedField(int width, int height, const KinectNoise& noise, uint32_t seed)
+{
+  std::mt19937 rng(seed ^ 0x9e3779b9u);
+  std::normal_distribution<float> gauss(0.0f, 1.0f);
+  const int radius = static_cast<int>(std::ceil(3.0 * noise.correlation_px));
+  // White noise with a margin of the kernel's radius, so the image's border is smoothed as its middle.
+  const int padded_width = width + 2 * radius, padded_height = height + 2 * radius;
+  std::vector<float> white(static_cast<size_t>(padded_width) * padded_height);
+  for (float& x : white) x = gauss(rng);
+  std::vector<float> kernel(2 * radius + 1);
+  double squares = 0.0;
+  for (int i = -radius; i <= radius; ++i)
+  {
+    kernel[i + radius] = static_cast<float>(std::exp(-0.5 * i * i / (noise.correlation_px * noise.correlation_px)));
+    squares += kernel[i + radius] * kernel[i + radius];
+  }
+  // Unit sum of squares: each pass, and so both, keep a unit variance.
+  for (float& w : kernel) w = static_cast<float>(w / std::sqrt(squares));
+  std::vector<float> rows(static_cast<size_t>(width) * padded_height), field(static_cast<size_t>(width) * height);
+  for (int v = 0; v < padded_height; ++v)
+    for (int u = 0; u < width; ++u)
+    {
+      float sum = 0.0f;
+      for (int i = 0; i <= 2 * radius; ++i) sum += kernel[i] * white[static_cast<size_t>(v) * padded_width + u + i];
+      rows[static_cast<size_t>(v) * width + u] = sum;
+    }
+  const float correlated = static_cast<float>(std::sqrt(noise.correlated_variance));
+  const float independent = static_cast<float>(std::sqrt(noise.independent_variance));
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u)
+    {
+      float sum = 0.0f;
+      for (int i = 0; i <= 2 * radius; ++i) sum += kernel[i] * rows[static_cast<size_t>(v + i) * width + u];
+      field[static_cast<size_t>(v) * width + u] = correlated * sum + independent * gauss(rng);
+    }
+  return field;
+}
+}  // namespace
+
 RenderedFrame SceneRenderer::render(const Eigen::Isometry3d& camera_to_world, const KinectNoise& noise,
                                     uint32_t seed) const
 {
@@ -117,6 +161,8 @@ RenderedFrame SceneRenderer::render(const Eigen::Isometry3d& camera_to_world, co
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, 1.0);
   const double fb = k.fx * noise.baseline;
+  const std::vector<float> field = noise.correlation_px > 0.0 ? correlatedField(k.width, k.height, noise, seed)
+                                                              : std::vector<float>();
 
   for (int v = 0; v < k.height; ++v)
   {
@@ -176,7 +222,8 @@ RenderedFrame SceneRenderer::render(const Eigen::Isometry3d& camera_to_world, co
       if (best_plane >= 0) ++frame.visible_points[best_plane];
       frame.pixel_plane[pixel] = best_plane;
       double depth = best_t;
-      if (noise.gaussian) depth += kinectNoiseSigma(best_t, noise.coefficient) * gauss(rng);
+      if (noise.gaussian)
+        depth += kinectNoiseSigma(best_t, noise.coefficient) * (field.empty() ? gauss(rng) : field[pixel]);
       if (noise.quantize)
       {
         // Depth comes from disparity in 1/subpixel pixel steps: the step grows with depth^2.
