@@ -179,7 +179,8 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
     const FramePlane* fitted = nullptr;
     double fitted_angle = kMatchAngle;
     for (const FramePlane& p : detector.lastFramePlanes())
-      if (unsignedAngle(p.normal, best->normal) <= fitted_angle && std::abs(p.d - best->d) <= kMatchDistance)
+      if (unsignedAngle(p.normal, best->normal) <= fitted_angle &&
+          std::abs((p.normal.dot(best->normal) >= 0.0 ? p.d : -p.d) - best->d) <= kMatchDistance)
       {
         fitted_angle = unsignedAngle(p.normal, best->normal);
         fitted = &p;

@@ -5,7 +5,8 @@
 // same scoring as make evaluate (PCL's methods left out). The held-out seeds are not here on
 // purpose: their figures come from make evaluate only, after a change is decided.
 // With --osd, the annotated real frames of osd-learn too (one frame each, PCL left out).
-// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--list] [--PARAM VALUE ...] (see --help)
+// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--list] [--noise-correlation PX] [--PARAM VALUE ...]
+// (see --help)
 #include <cstdio>
 #include <functional>
 #include <future>
@@ -45,11 +46,11 @@ struct SetResult
 std::string describeFalsePlane(const std::string& where, int frame, const PlaneDetector& detector,
                                const DetectedPlane& plane, const std::vector<TruePlane>& truth)
 {
+  const MatchTolerance tolerance;
   double best_cost = 1e9, best_angle = 0.0, best_distance = 0.0;
   for (const TruePlane& t : truth)
   {
     const double angle = angleError(plane.normal, t.normal), distance = distanceError(plane.normal, plane.d, t.normal, t.d);
-    const MatchTolerance tolerance;
     if (angle / tolerance.angle + distance / tolerance.distance < best_cost)
     {
       best_cost = angle / tolerance.angle + distance / tolerance.distance;
@@ -109,7 +110,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
 SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const ParamsFor& params_for,
                    double noise_override = 0.0)
 {
-  SetResult result{name, {}, {}};
+  SetResult result{name, {}, {}, {}};
   for (uint32_t seed : seeds)
   {
     RandomScene room = makeRandomScene(seed, kRoomFrames);
@@ -123,7 +124,7 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
 
 SetResult runTableThree(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's tours", {}, {}};
+  SetResult result{"Table 3's tours", {}, {}, {}};
   for (const NamedScene& named : tableThreeScenes())
     runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, 3, params_for(1.0), result);
   return result;
@@ -131,7 +132,7 @@ SetResult runTableThree(const ParamsFor& params_for)
 
 SetResult runOtherTours(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's scenes, other tours", {}, {}};
+  SetResult result{"Table 3's scenes, other tours", {}, {}, {}};
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
       runSequence(std::string(named.name) + ", " + tour.name, named.scene,
@@ -142,7 +143,7 @@ SetResult runOtherTours(const ParamsFor& params_for)
 SetResult runFigureSeven(const ParamsFor& params_for)
 {
   // As make evaluate runs Fig. 7: the paper's thinning, the office at C = 4, resolution 1024.
-  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}};
+  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}};
   DetectorParams params = params_for(4.0);
   params.forgetting = kForgetByThinning;
   runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kFigureSevenStride, params,

@@ -74,8 +74,10 @@ struct KinectNoise
   // Real structured-light noise is spatially correlated (a disparity is matched over a window of
   // pixels). With correlation_px > 0 the noise is a Gaussian-smoothed field of that many pixels
   // (sigma) carrying `correlated_variance` of eq. 11's variance, plus an independent share
-  // `independent_variance`; osd-learn's frames (evaluate_osd --noise, about 1 m) show about 0.16
-  // and 0.05. 0 (default): all of it independent per pixel.
+  // `independent_variance`. At 8 px, 0.16 and 0.05 give a block's spread along its plane of 0.04
+  // of eq. 11's sigma^2, as osd-learn's tables show 0.052 (evaluate_osd --noise); their block
+  // centroids stray further still (3 times the modelled variance, this field about half of it).
+  // 0 (default): all of it independent per pixel.
   double correlation_px = 0.0;
   double correlated_variance = 0.16;
   double independent_variance = 0.05;
