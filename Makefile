@@ -51,7 +51,7 @@ help:
 	@echo "make demo-offline  the core alone on the simulated room, with per-frame figures"
 	@echo "make bench         time per frame and accuracy against PCL RANSAC and OMPS"
 	@echo "make evaluate      the paper's experiments, held-out rooms, real frames -> docs/RESULTS.md (QUICK=1: short)"
-	@echo "make tuning-check  the rendered sets a detector change may be tuned on, one line each, and osd-learn (ARGS=--causes, --list, --PARAM VALUE)"
+	@echo "make tuning-check  the rendered sets a detector change may be tuned on, one line each, and osd-learn (ARGS=--causes, --list, --noise-correlation PX, --PARAM VALUE)"
 	@echo "make soak          10,000 frames through the core, then the nodelet (memory, ms, valgrind's leak checks)"
 	@echo "make soak-control  the leak check's negative control (must report a leak)"
 	@echo "make clean         remove build/"
