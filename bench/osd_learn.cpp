@@ -434,11 +434,6 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
 
 std::string osdNoiseMarkdown(const OsdResults& results)
 {
-  auto median = [](std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
   char line[320];
   std::snprintf(line, sizeof(line),
                 "Noise on the table's %zu blocks against the model: spread along the normal / sigma^2 median %.3f "
