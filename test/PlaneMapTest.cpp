@@ -408,6 +408,36 @@ TEST(PlaneMap, AFittingRegionIsReportedAtFirstSightOnlyWhenPrecise)
   }
 }
 
+// A precise new face near a known plane waits for a second frame only when it could be that
+// plane measured badly: turned 0.08 rad (under three merge angles) about a point on the known
+// wall it waits; the same turn 20 cm in front of the wall and 3 m along it (offsets 3 cm apart
+// at the world origin, 20 cm apart where it was measured) is another surface, reported at once.
+TEST(PlaneMap, ANewFaceWaitsOnlyWhereAKnownPlanePassesItsPoints)
+{
+  const Eigen::Vector3d turned(std::cos(0.08), std::sin(0.08), 0.0);
+  for (const Eigen::Vector3d& centroid : {Eigen::Vector3d(2.0, 0.0, 1.0), Eigen::Vector3d(1.8, 3.0, 1.0)})
+  {
+    const bool on_wall = centroid.x() == 2.0;
+    Map m;
+    FramePlane wall = m.plane(Eigen::Vector3d(1, 0, 0), -2.0, 20000);
+    wall.fits_its_blocks = true;
+    wall.normal_sigma = 0.002;
+    wall.offset_sigma = 0.001;
+    wall.centroid = Eigen::Vector3d(2.0, 0.0, 1.0);
+    m.frame({wall}, 0.0);
+    ASSERT_EQ(m.map.planes().size(), 1u);
+    FramePlane face = m.plane(turned, -turned.dot(centroid), 3000);
+    face.fits_its_blocks = true;
+    face.normal_sigma = 0.002;
+    face.offset_sigma = 0.001;
+    face.centroid = centroid;
+    m.frame({wall, face}, 0.1);
+    EXPECT_EQ(matching(m.map.planes(), turned).size(), on_wall ? 0u : 1u)
+        << "face centred at (" << centroid.transpose() << "), offset at the origin "
+        << std::abs(face.d - wall.d) << " m from the wall's";
+  }
+}
+
 // A region whose blocks lie off its plane beyond their noise (FramePlane::mixes_surfaces: two
 // box faces a few degrees apart grown as one) is not reported from one frame, however many
 // points it has; the same region with its blocks on its plane is.

@@ -445,10 +445,20 @@ void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
 
 bool PlaneMap::nearKnownPlane(const FramePlane& measured) const
 {
+  // A tilted fit of a surface turns about its points' centroid, which stays on the surface: a
+  // measurement where it was made (offset_sigma > 0) is that plane's only if the plane passes
+  // its centroid. Offsets at the world origin would tie a face to any near-parallel one metres
+  // away (a box's back 0.08 rad off another box's side, 8 cm apart at the origin).
+  const double max_angle = kNearTolerances * params_.merge_angle;
+  const double max_distance = kNearTolerances * params_.merge_distance;
   for (const DetectedPlane& known : planes_)
-    if (withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, kNearTolerances * params_.merge_angle,
-                              kNearTolerances * params_.merge_distance))
+  {
+    if (measured.offset_sigma > 0.0
+            ? unsignedAngle(known.normal, measured.normal) <= max_angle &&
+                  std::abs(known.normal.dot(measured.centroid) + known.d) <= max_distance
+            : withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, max_angle, max_distance))
       return true;
+  }
   return false;
 }
 

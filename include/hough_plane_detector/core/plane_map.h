@@ -92,8 +92,9 @@ private:
   void thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes);
   // True when the frame's plane lies on the map's within the merge tolerances (either side).
   bool samePlane(const DetectedPlane& known, const FramePlane& measured) const;
-  // True when a map plane lies within three merge tolerances of the frame's plane: more likely
-  // a noisy re-measurement of it than a new surface, so it is not reported at first sight.
+  // True when a map plane lies within three merge tolerances of the frame's plane, its offset
+  // judged at the frame plane's centroid when known: more likely a noisy re-measurement of it
+  // than a new surface, so it is not reported at first sight.
   bool nearKnownPlane(const FramePlane& measured) const;
   // True when the frame's plane is precise enough that a second measurement of it falls within
   // the merge tolerances of it: its normal, and its offset at its own points.
