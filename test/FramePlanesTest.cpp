@@ -33,13 +33,7 @@ TEST(FramePlaneFitter, BothFitsRecoverTheFloorAndTheWallFromTheirPeaks)
       for (const FramePlane& plane : planes)
         if (angleBetween(plane.normal, truth->normal) < 0.005 &&
             std::abs(std::abs(plane.d) - std::abs(truth->d)) < 0.005 && plane.support > 5000)
-        {
           ++found;
-          // The renderer's noise is independent per pixel and dithers the disparity steps, so
-          // a flat face's blocks scatter below the model's variance (0.46 floor, 0.15 wall here).
-          if (region_growing)
-            EXPECT_LT(plane.variance_factor, 0.7) << truth->name;
-        }
       EXPECT_EQ(found, 1) << truth->name;
     }
     EXPECT_EQ(candidates.front().verdict, CandidateVerdict::kAccepted);
@@ -182,5 +176,4 @@ TEST(FramePlaneFitter, ARegionOverTwoFacesThatCrossMidwayIsFlaggedAsMixing)
   ASSERT_NE(backs, nullptr) << "one region over both backs";
   EXPECT_TRUE(backs->mixes_surfaces);
   EXPECT_FALSE(backs->fits_its_blocks);
-  EXPECT_GT(backs->variance_factor, 1.0) << "its blocks scatter beyond their noise";
 }

@@ -299,9 +299,6 @@ void FramePlaneFitter::testFitToBlocks(FramePlane& plane, const std::vector<int>
   const Eigen::Vector3d n_cam = frame_.normalInCamera(plane.normal);
   const double mean_chi2 = tests_.centroidChi2(n_cam, frame_.dInCamera(plane.normal, plane.d), blocks);
   plane.mixes_surfaces = mean_chi2 > noiseBoundOfMeanChi2(blocks.size());
-  // A plane through the blocks takes 3 of their degrees of freedom.
-  const double blocks_count = static_cast<double>(blocks.size());
-  plane.variance_factor = mean_chi2 * blocks_count / std::max(1.0, blocks_count - 3.0);
   if (mean_chi2 > 1.0) return;
   const std::vector<int> interior = interiorBlocks(blocks, frame_.blocksX(), frame_.blocksY());
   if (interior.size() < kMinInteriorBlocks) return;

@@ -411,13 +411,9 @@ bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
   // Two measurements of one surface differ by sqrt(2) sigma; both tolerances hold at 2 sigma
   // of that difference. The offset is judged where the surface was measured, at its points: a
   // far face's small tilt error moves its offset at the world origin, not the surface shown.
-  // The normal's sigma is the noise model's scaled by how far its blocks actually scatter about
-  // it (the a-posteriori variance factor): where quantization averages out, as in rendered
-  // frames, they scatter far less than modelled. Never above the model's: a region whose blocks
-  // scatter more does not fit them (fits_its_blocks) and waits for a second frame anyway.
   constexpr double kSigmas = 2.0 * M_SQRT2;
-  const double normal_sigma = measured.normal_sigma * std::sqrt(std::min(1.0, measured.variance_factor));
-  return kSigmas * normal_sigma <= params_.merge_angle && kSigmas * measured.offset_sigma <= params_.merge_distance;
+  return kSigmas * measured.normal_sigma <= params_.merge_angle &&
+         kSigmas * measured.offset_sigma <= params_.merge_distance;
 }
 
 void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)

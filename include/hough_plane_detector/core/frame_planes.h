@@ -64,9 +64,6 @@ struct FramePlane
   // Its blocks' centroids lie off it beyond their noise (p = 0.01, noiseBoundOfMeanChi2): it
   // took blocks of another surface or bends, so one frame does not report it (plane_map.cpp).
   bool mixes_surfaces = false;
-  // Its blocks' centroid chi^2 about it per degree of freedom: the a-posteriori variance factor
-  // of its fit, 1 when the noise model holds or it has no blocks.
-  double variance_factor = 1.0;
   std::vector<int> blocks;  // region_growing: the blocks of its region
   // Snapped: the normal the blocks that measured it fit by themselves (world frame, on the side
   // of `normal`) and its information (1/rad^2), so that the map can test over frames whether
