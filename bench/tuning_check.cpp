@@ -196,8 +196,7 @@ int main(int argc, char** argv)
   }
   std::vector<std::pair<std::string, std::string>> overrides;
   for (const auto& value : values)
-    if (value.first != "sets" && value.first != "causes" && value.first != "list" && value.first != "noise-correlation" && value.first != "help" &&
-        value.first != "osd")
+    if (detector_options.find_nothrow(value.first, false))  // the detector's parameters, not this tool's options
       overrides.emplace_back(value.first, value.second.as<std::string>());
   // Each room's sensor_noise as make evaluate sets it, then the flags given.
   const ParamsFor params_for = [&overrides](double noise) {
