@@ -214,7 +214,7 @@ void benchVariants(const std::vector<RenderedFrame>& rendered)
 // Real Kinect frames, a still camera: each file five times into one map; PCL's methods once.
 bool benchRealFrames(const std::vector<std::string>& paths)
 {
-  PlaneDetector real{DetectorParams()};
+  PlaneDetector real{cameraFrameDefaults()};
   std::vector<double> ours_ms, ransac_ms, organized_ms;
   size_t ours_planes = 0, ransac_planes = 0, organized_planes = 0;
   for (int rep = 0; rep < 5; ++rep)

@@ -41,6 +41,7 @@ int main(int argc, char** argv)
     return 0;
   }
   const bool with_pcl = !values.count("no-pcl"), misses = values.count("misses") > 0, errors = values.count("errors") > 0;
+  assumeCameraFrame(values, params);
   OsdResults results;
   std::string error;
   if (!evaluateOsdLearn(dir, params, with_pcl, errors, picture_dir, results, &error))

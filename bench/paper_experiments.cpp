@@ -316,6 +316,7 @@ RandomSceneExperiment runRandomScenes(bool quick)
       {"**defaults (block regions)**", [](DetectorParams&) {}},
       {"no parallel search", [](DetectorParams& p) { p.parallel_support = 0; }},
       {"no snap", [](DetectorParams& p) { p.snap_angle = 0.0; }},
+      {"snaps by the noise model alone (world_z_up 0)", [](DetectorParams& p) { p.world_z_up = 0; }},
       {"forgetting by thinning (the paper)", [](DetectorParams& p) { p.forgetting = kForgetByThinning; }},
       {"windows (region_growing 0)", [](DetectorParams& p) { p.region_growing = 0; }},
   };
@@ -395,7 +396,7 @@ bool runRealFrames(const std::vector<std::string>& paths, const std::string& pic
     pcl::PCLPointCloud2 blob;
     CloudView view;
     std::vector<float> converted;
-    PlaneDetector detector{DetectorParams()};
+    PlaneDetector detector{cameraFrameDefaults()};
     std::string problem;
     if (!loadPcd(paths[i], blob, &problem) || !makeCloudView(layoutOf(blob), view, converted, &problem) ||
         !detector.processFrame(view, Eigen::Isometry3d::Identity(), 0.0, &problem))

@@ -242,7 +242,9 @@ int main(int argc, char** argv)
   for (auto& result : results) print(result.get(), causes, list_planes);
   if (osd_dir.empty()) return 0;
   OsdResults osd;
-  if (!evaluateOsdLearn(osd_dir, params_for(0.0), false, false, "", osd, &error))
+  DetectorParams osd_params = params_for(0.0);
+  assumeCameraFrame(values, osd_params);
+  if (!evaluateOsdLearn(osd_dir, osd_params, false, false, "", osd, &error))
   {
     std::cerr << "tuning_check: " << error << "\n";
     return 1;

@@ -244,6 +244,31 @@ TEST(DetectPlanesCli, NumbersAreTheWholeTextOrRefused)
   EXPECT_NE(refused.output.find("min_support needs an integer"), std::string::npos) << refused.output;
 }
 
+// A PCD in its camera's own frame says nothing of gravity: world_z_up is 0 for it unless the
+// command line set it (either spelling).
+TEST(DetectPlanesCli, ACloudInItsCamerasFrameAssumesNoUpUnlessTold)
+{
+  namespace po = boost::program_options;
+  auto parsed = [](std::vector<const char*> argv) {
+    DetectorParams params;
+    po::options_description visible, hidden, all;
+    addDetectorParamOptions(params, visible, hidden);
+    all.add(visible).add(hidden);
+    po::variables_map values;
+    argv.insert(argv.begin(), "detect_planes");
+    std::string error;
+    EXPECT_TRUE(parseCommandLine(static_cast<int>(argv.size()), const_cast<char**>(argv.data()), all,
+                                 po::positional_options_description(), values, &error))
+        << error;
+    assumeCameraFrame(values, params);
+    return params.world_z_up;
+  };
+  ASSERT_EQ(DetectorParams().world_z_up, 1) << "the default is a REP 103 world frame";
+  EXPECT_EQ(parsed({"--snap_angle", "0.1"}), 0);
+  EXPECT_EQ(parsed({"--world_z_up", "1"}), 1);
+  EXPECT_EQ(parsed({"--world-z-up", "1"}), 1);
+}
+
 // A file whose header is not a PCD header is refused by name before PCL's reader sees it
 // (PCL 1.13 crashed on one line of text).
 TEST(DetectPlanesCli, RefusesFilesThatAreNotPcd)

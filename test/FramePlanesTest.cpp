@@ -88,6 +88,58 @@ TEST(FramePlaneFitter, ASnapPrefersTheKnownPlaneThePieceLiesOn)
   EXPECT_NEAR(std::abs(d), std::abs(wall.d), 0.02);
 }
 
+// A wall patch of 81 blocks and a known plane turned 0.02 rad about the vertical: the noise
+// model cannot tell the two normals apart (rendered faces scatter well below it), the
+// patch's own scatter can. With the world's up known, a face off the vertical keeps its own
+// normal (boxes at any yaw are parallel only by chance); a floor patch still takes a known
+// normal as far off, since level surfaces are parallel by gravity; with up unknown both snap.
+TEST(FramePlaneFitter, AFaceOffTheVerticalSnapsOnlyIfItsOwnScatterCannotTellTheNormals)
+{
+  Frame f;
+  const int bx_count = f.frame.blocksX();
+  // The blocks of a true plane within a k x k square around the middle one of its list.
+  auto patch = [&](const std::string& name, int k) {
+    const std::vector<int> on = f.blocksOn(f.truePlane(name));
+    const int middle = on[on.size() / 2];
+    std::vector<int> blocks;
+    for (int b : on)
+      if (std::abs(b % bx_count - middle % bx_count) <= k / 2 && std::abs(b / bx_count - middle / bx_count) <= k / 2)
+        blocks.push_back(b);
+    return blocks;
+  };
+  struct Case
+  {
+    const char* plane;
+    int k;
+    double turn;
+    Eigen::Vector3d axis;
+    bool snaps_with_up_known;
+  };
+  for (const Case& c : {Case{"wall", 9, 0.02, Eigen::Vector3d::UnitZ(), false},
+                        Case{"floor", 9, 0.01, Eigen::Vector3d::UnitY(), true}})
+  {
+    const TruePlane& truth = f.renderer.truePlanes()[f.truePlane(c.plane)];
+    const std::vector<int> blocks = patch(c.plane, c.k);
+    ASSERT_GT(blocks.size(), 40u) << c.plane;
+    DetectedPlane known;
+    known.normal = Eigen::AngleAxisd(c.turn, c.axis) * truth.normal;
+    known.d = truth.d;
+    const PlanarityTests::NormalExplanation explained =
+        f.tests.explainNormal(f.frame.normalInCamera(known.normal), blocks, false);
+    ASSERT_TRUE(explained.interior) << c.plane << ": the noise model must not tell the normals, or this shows nothing";
+    ASSERT_FALSE(explained.interior_within_own_scatter) << c.plane << ": its own scatter must tell them";
+    for (int up_known = 0; up_known <= 1; ++up_known)
+    {
+      f.params.world_z_up = up_known;
+      FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
+      Eigen::Vector3d normal = truth.normal;
+      double d = truth.d;
+      EXPECT_EQ(fitter.snapToKnownDirection(normal, d, blocks, {known}, {}), !up_known || c.snaps_with_up_known)
+          << c.plane << ", world_z_up " << up_known;
+    }
+  }
+}
+
 // A table's top 3 m away, 45 cm below the camera, grown as a region with the floor known: rim
 // blocks at its far edge lean over it, its own fit tilts and it takes the floor's normal. The
 // snapped plane is measured by the blocks on it (its whole region's centroids lie off it beyond

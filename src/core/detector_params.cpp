@@ -67,6 +67,7 @@ bool DetectorParams::validate(std::string* error) const
   if (!(support_angle > 0.0 && support_angle < 1.5)) err << "support_angle must be in (0, 1.5) rad, got " << support_angle << "; ";
   if (parallel_support < 0) err << "parallel_support must be >= 0, got " << parallel_support << "; ";
   if (!(snap_angle >= 0.0 && snap_angle < 0.5)) err << "snap_angle must be in [0, 0.5) rad, got " << snap_angle << "; ";
+  if (world_z_up != 0 && world_z_up != 1) err << "world_z_up must be 0 or 1, got " << world_z_up << "; ";
   if (region_growing != 0 && region_growing != 1) err << "region_growing must be 0 or 1, got " << region_growing << "; ";
   if (measurement_threads < 1 || measurement_threads > 8)
     err << "measurement_threads must be in [1, 8], got " << measurement_threads << "; ";

@@ -15,6 +15,7 @@ namespace hough_plane_detector
 namespace
 {
 constexpr double kMinSnapInlierShare = 0.8;  // snapping: points that must lie on the parallel plane
+constexpr double kLevelSurfaceCosine = 0.9;   // within 26 deg of level: what one walks or sets things on
 }  // namespace
 
 const char* toString(CandidateVerdict verdict)
@@ -573,6 +574,11 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
   const PlanarityTests::NormalExplanation explained = tests_.explainNormal(n_cam, inliers, true);
   if (!explained.interior) return false;
+  // Gravity keeps level surfaces parallel to a fraction of a degree (floors, treads, ramps,
+  // table and shelf tops); faces of other directions are parallel by design or by chance (boxes
+  // at any yaw). A snap onto those must also hold against the face's own scatter.
+  if (params_.world_z_up && std::abs(known.z()) < kLevelSurfaceCosine && !explained.interior_within_own_scatter)
+    return false;
   // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
   // explains the face, its own normal is the better model, when the points determine it.
   if (!explained.with_oriented_rim && normalDetermined(tests_.normalUncertainty(inliers))) return false;

@@ -185,18 +185,43 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
   return moments;
 }
 
+namespace
+{
+// True when the blocks lie in more than one row and more than one column of the block grid.
+bool spansRowsAndColumns(const std::vector<int>& blocks, int blocks_x)
+{
+  if (blocks.empty()) return false;
+  bool rows = false, columns = false;
+  for (int b : blocks)
+  {
+    rows |= b / blocks_x != blocks.front() / blocks_x;
+    columns |= b % blocks_x != blocks.front() % blocks_x;
+  }
+  return rows && columns;
+}
+}  // namespace
+
 PlanarityTests::NormalExplanation PlanarityTests::explainNormal(const Eigen::Vector3d& n_cam,
                                                                const std::vector<int>& blocks, bool with_rim) const
 {
   NormalExplanation verdict;
   std::vector<int> tested = interiorBlocks(blocks, frame_.normals.blocksX(), frame_.normals.blocksY());
-  if (tested.size() < kMinInteriorBlocks)
+  const bool no_interior = tested.size() < kMinInteriorBlocks;
+  // No interior to tell from the rim: all blocks are tested, once for both verdicts.
+  if (no_interior) tested = blocks;
+  const SnapChi2 chi2 = snapChi2(n_cam, tested);
+  verdict.interior = chi2.fixed - chi2.free <= kMaxSnapChi2Increase;
+  const double free_dof = static_cast<double>(tested.size()) - 3.0;  // a plane's three parameters
+  // Without an interior the scatter includes the rim's lean that a snap exists to undo; an
+  // interior of one block row or column (a narrow riser's) fits a pencil of planes exactly.
+  verdict.interior_within_own_scatter =
+      verdict.interior && (no_interior || !spansRowsAndColumns(tested, frame_.normals.blocksX()) ||
+                           (chi2.fixed - chi2.free) / 2.0 <= fCriticalTwo(free_dof, 0.01) * chi2.free / free_dof);
+  if (no_interior)
   {
-    // No interior to tell from the rim: all blocks are tested, once for both verdicts.
-    verdict.interior = verdict.with_oriented_rim = snapChi2Increase(n_cam, blocks) <= kMaxSnapChi2Increase;
+    verdict.with_oriented_rim = verdict.interior;
     return verdict;
   }
-  verdict.interior = snapChi2Increase(n_cam, tested) <= kMaxSnapChi2Increase;
   if (!with_rim || !verdict.interior) return verdict;
   std::vector<int> interior = tested;
   std::sort(interior.begin(), interior.end());
@@ -225,7 +250,7 @@ PointMoments PlanarityTests::noiseWeightedCentroids(const std::vector<int>& bloc
   return sum;
 }
 
-double PlanarityTests::snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
+PlanarityTests::SnapChi2 PlanarityTests::snapChi2(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
 {
   // Centroids weighted by their inverse variance: the smallest eigenvalue of their scatter
   // times the total weight is the chi^2 of the best free plane; the fixed normal's best plane
@@ -241,11 +266,13 @@ double PlanarityTests::snapChi2Increase(const Eigen::Vector3d& n_cam, const std:
     offset_sum += weight * offset;
     offset_squares += weight * offset * offset;
   }
-  if (weight_sum <= 0.0) return 0.0;
-  const double fixed_chi2 = offset_squares - offset_sum * offset_sum / weight_sum;
+  SnapChi2 chi2;
+  if (weight_sum <= 0.0) return chi2;
+  chi2.fixed = offset_squares - offset_sum * offset_sum / weight_sum;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(sum.covariance());
-  return fixed_chi2 - std::max(0.0, solver.eigenvalues()(0)) * sum.count;
+  chi2.free = std::max(0.0, solver.eigenvalues()(0)) * sum.count;
+  return chi2;
 }
 
 bool PlanarityTests::ownNormal(const std::vector<int>& blocks, OwnNormal& own) const

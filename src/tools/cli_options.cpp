@@ -116,6 +116,11 @@ void addDetectorParamOptions(DetectorParams& params, boost::program_options::opt
   }
 }
 
+void assumeCameraFrame(const boost::program_options::variables_map& values, DetectorParams& params)
+{
+  if (!values.count("world_z_up") && !values.count("world-z-up")) params.world_z_up = 0;
+}
+
 bool parseCommandLine(int argc, char** argv, const boost::program_options::options_description& options,
                       const boost::program_options::positional_options_description& positional,
                       boost::program_options::variables_map& values, std::string* error)

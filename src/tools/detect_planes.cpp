@@ -150,6 +150,7 @@ int main(int argc, char** argv)
     std::cerr << "detect_planes: --bag needs --topic\n";
     return 2;
   }
+  if (!pcd_paths.empty()) assumeCameraFrame(values, params);
   std::string problem;
   if (!params.validate(&problem))
   {

@@ -33,6 +33,7 @@
   X(double, support_angle)             \
   X(int, parallel_support)             \
   X(double, snap_angle)                \
+  X(int, world_z_up)                   \
   X(int, region_growing)               \
   X(int, forgetting)                   \
   X(int, measurement_threads)
@@ -119,6 +120,12 @@ struct DetectorParams
   // most of its points lie on the parallel plane within their noise (a far stair tread leaning
   // on its edges); 0 never.
   double snap_angle = 0.1;
+  // 1: the world frame's +z points up (REP 103: odom, map). A plane then takes a known normal
+  // more than 26 deg off the vertical only if its points' own scatter, not just the noise
+  // model, cannot tell the two apart (an F test): level surfaces are parallel by gravity, box
+  // faces at any yaw only by chance. 0: up is unknown (a PCD in its camera's frame), every snap
+  // is judged by the noise model alone.
+  int world_z_up = 1;
   // Per-frame planes: 1 = each Hough peak seeds regions of 8 x 8 pixel blocks grown while they
   // lie on the refitted plane within the sensor's noise, then the flat blocks left seed regions
   // of their own (small faces that raise no peak); 0 = each peak takes the windows that agree
@@ -138,5 +145,13 @@ struct DetectorParams
   double effectiveAngleStep() const;
   double effectiveDStep() const;
 };
+
+// The defaults for clouds in their camera's own frame (a PCD file alone): up is unknown.
+inline DetectorParams cameraFrameDefaults()
+{
+  DetectorParams params;
+  params.world_z_up = 0;
+  return params;
+}
 
 }  // namespace hough_plane_detector

@@ -29,6 +29,9 @@ void addDetectorParamOptions(DetectorParams& params, boost::program_options::opt
 bool parseCommandLine(int argc, char** argv, const boost::program_options::options_description& options,
                       const boost::program_options::positional_options_description& positional,
                       boost::program_options::variables_map& values, std::string* error);
+// A cloud given in its camera's own frame (a PCD file, an osd-learn frame) says nothing of
+// gravity: world_z_up becomes 0 unless the command line set it, either spelling.
+void assumeCameraFrame(const boost::program_options::variables_map& values, DetectorParams& params);
 
 // {"frame": 0, "stamp": 12.34, "frame_id": "odom", "ms": 4.2, "planes": [...]}; `outlines`,
 // when given, holds each plane's region shapes (PlaneDetector::outlines), in the planes' order.
