@@ -576,8 +576,11 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   if (!explained.interior) return false;
   // Gravity keeps level surfaces parallel to a fraction of a degree (floors, treads, ramps,
   // table and shelf tops); faces of other directions are parallel by design or by chance (boxes
-  // at any yaw). A snap onto those must also hold against the face's own scatter.
-  if (params_.world_z_up && std::abs(known.z()) < kLevelSurfaceCosine && !explained.interior_within_own_scatter)
+  // at any yaw). A snap onto those must also hold against the face's own scatter, where that is
+  // one face's: a grown region's. The windows' blocks are all within support_distance of the
+  // peak's plane (a cabinet front and a desk's edge 3 cm before it): their scatter is the mix.
+  if (params_.world_z_up && params_.region_growing && std::abs(known.z()) < kLevelSurfaceCosine &&
+      !explained.interior_within_own_scatter)
     return false;
   // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
   // explains the face, its own normal is the better model, when the points determine it.
