@@ -15,7 +15,6 @@ namespace hough_plane_detector
 namespace
 {
 constexpr double kMinSnapInlierShare = 0.8;  // snapping: points that must lie on the parallel plane
-constexpr double kLevelSurfaceCosine = 0.9;   // within 26 deg of level: what one walks or sets things on
 }  // namespace
 
 const char* toString(CandidateVerdict verdict)
@@ -579,9 +578,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // at any yaw). A snap onto those must also hold against the face's own scatter, where that is
   // one face's: a grown region's. The windows' blocks are all within support_distance of the
   // peak's plane (a cabinet front and a desk's edge 3 cm before it): their scatter is the mix.
-  if (params_.world_z_up && params_.region_growing && std::abs(known.z()) < kLevelSurfaceCosine &&
-      !explained.interior_within_own_scatter)
-    return false;
+  if (tests_.judgedOnOwnScatter(known) && !explained.interior_within_own_scatter) return false;
   // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
   // explains the face, its own normal is the better model, when the points determine it.
   if (!explained.with_oriented_rim && normalDetermined(tests_.normalUncertainty(inliers))) return false;

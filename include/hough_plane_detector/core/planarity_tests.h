@@ -19,6 +19,7 @@ namespace hough_plane_detector
 constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
 constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
 constexpr double kMaxSnapChi2Increase = 9.21;      // a known normal's fit: chi^2 with 2 dof, p = 0.01
+constexpr double kLevelSurfaceCosine = 0.9;        // within 26 deg of level: what one walks or sets things on
 
 // The mean chi^2 per block that n block centroids exceed about their true plane with p = 0.01
 // (chi^2 with n dof over n, its normal approximation).
@@ -73,6 +74,13 @@ public:
     bool interior_within_own_scatter = false;
   };
   NormalExplanation explainNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks, bool with_rim) const;
+  // Whether a plane taking this known world normal must also pass interior_within_own_scatter:
+  // with the world's up known (world_z_up), a grown region and a normal more than 26 deg off
+  // the vertical.
+  bool judgedOnOwnScatter(const Eigen::Vector3d& known_normal) const
+  {
+    return params_.world_z_up && params_.region_growing && std::abs(known_normal.z()) < kLevelSurfaceCosine;
+  }
   // How much more chi^2 the block centroids have about their best plane of the camera-frame
   // normal than about their own best plane (both with the centroids' noise).
   double snapChi2Increase(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
