@@ -120,8 +120,9 @@ struct DetectorParams
   // most of its points lie on the parallel plane within their noise (a far stair tread leaning
   // on its edges); 0 never.
   double snap_angle = 0.1;
-  // 1: the world frame's +z points up (REP 103: odom, map). A region then takes a known normal
-  // more than 26 deg off the vertical only if its points' own scatter, not just the noise
+  // 1: the world frame's +z points up (REP 103: odom, map). A region (or a parallel-search
+  // cluster) then takes a known normal more than 26 deg off the vertical only if its points'
+  // own scatter, not just the noise
   // model, cannot tell the two apart (an F test): level surfaces are parallel by gravity, box
   // faces at any yaw only by chance. 0: up is unknown (a PCD in its camera's frame), every snap
   // is judged by the noise model alone.
