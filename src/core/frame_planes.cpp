@@ -572,13 +572,12 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // off an older box's would take its direction. Judged on the interior: rim blocks straddling
   // a fold (a ramp's foot, a tread's nosing) are the lean the snap exists to undo.
   const PlanarityTests::NormalExplanation explained = tests_.explainNormal(n_cam, inliers, true);
-  if (!explained.interior) return false;
   // Gravity keeps level surfaces parallel to a fraction of a degree (floors, treads, ramps,
   // table and shelf tops); faces of other directions are parallel by design or by chance (boxes
   // at any yaw). A snap onto those must also hold against the face's own scatter, where that is
   // one face's: a grown region's. The windows' blocks are all within support_distance of the
   // peak's plane (a cabinet front and a desk's edge 3 cm before it): their scatter is the mix.
-  if (tests_.judgedOnOwnScatter(known) && !explained.interior_within_own_scatter) return false;
+  if (!tests_.acceptsKnownNormal(explained, known)) return false;
   // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
   // explains the face, its own normal is the better model, when the points determine it.
   if (!explained.with_oriented_rim && normalDetermined(tests_.normalUncertainty(inliers))) return false;

@@ -191,7 +191,8 @@ private:
     PlaneCandidate candidate{normal_, d, 0.0, moments.count, CandidateVerdict::kAccepted, true};
     if (moments.count < params_.parallel_support)
       candidate.verdict = CandidateVerdict::kCurvedPatches;
-    else if (!tests_.fitIsParallel(n_cam_, blocks_) || !explainedByNormal())
+    else if (!tests_.fitIsParallel(n_cam_, blocks_) ||
+             !tests_.acceptsKnownNormal(tests_.explainNormal(n_cam_, blocks_, false), normal_))
       candidate.verdict = CandidateVerdict::kNotParallel;
     if (candidate.verdict == CandidateVerdict::kAccepted)
     {
@@ -214,14 +215,6 @@ private:
       addKnown(normal_, candidate.d, false);
     }
     candidates_.push_back(candidate);
-  }
-
-  // The known normal explains the cluster about as well as its own plane, as a snap's must: off
-  // the vertical also against the cluster's own scatter (two boxes' faces are parallel by chance).
-  bool explainedByNormal() const
-  {
-    const PlanarityTests::NormalExplanation explained = tests_.explainNormal(n_cam_, blocks_, false);
-    return explained.interior && (!tests_.judgedOnOwnScatter(normal_) || explained.interior_within_own_scatter);
   }
 
   const DetectorParams& params_;

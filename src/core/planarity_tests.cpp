@@ -215,8 +215,9 @@ PlanarityTests::NormalExplanation PlanarityTests::explainNormal(const Eigen::Vec
   // Without an interior the scatter includes the rim's lean that a snap exists to undo; an
   // interior of one block row or column (a narrow riser's) fits a pencil of planes exactly.
   verdict.interior_within_own_scatter =
-      verdict.interior && (no_interior || !spansRowsAndColumns(tested, frame_.normals.blocksX()) ||
-                           (chi2.fixed - chi2.free) / 2.0 <= fCriticalTwo(free_dof, 0.01) * chi2.free / free_dof);
+      verdict.interior && (no_interior ||
+                           (chi2.fixed - chi2.free) / 2.0 <= fCriticalTwo(free_dof, 0.01) * chi2.free / free_dof ||
+                           !spansRowsAndColumns(tested, frame_.normals.blocksX()));
   if (no_interior)
   {
     verdict.with_oriented_rim = verdict.interior;

@@ -74,12 +74,14 @@ public:
     bool interior_within_own_scatter = false;
   };
   NormalExplanation explainNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks, bool with_rim) const;
-  // Whether a plane taking this known world normal must also pass interior_within_own_scatter:
-  // with the world's up known (world_z_up), a grown region and a normal more than 26 deg off
-  // the vertical.
-  bool judgedOnOwnScatter(const Eigen::Vector3d& known_normal) const
+  // Whether a plane may take the known world normal `explained` was made for (a snap, a
+  // parallel cluster): its interior's verdict, and with the world's up known (world_z_up), for
+  // a grown region and a normal more than 26 deg off the vertical, its own scatter's too.
+  bool acceptsKnownNormal(const NormalExplanation& explained, const Eigen::Vector3d& known_normal) const
   {
-    return params_.world_z_up && params_.region_growing && std::abs(known_normal.z()) < kLevelSurfaceCosine;
+    const bool judged_on_own_scatter =
+        params_.world_z_up && params_.region_growing && std::abs(known_normal.z()) < kLevelSurfaceCosine;
+    return explained.interior && (!judged_on_own_scatter || explained.interior_within_own_scatter);
   }
   // How much more chi^2 the block centroids have about their best plane of the camera-frame
   // normal than about their own best plane (both with the centroids' noise).
