@@ -53,6 +53,15 @@ struct OsdFitError
   double own_angle = 0.0, own_sigma = 0.0;
 };
 
+// A found face's normal error, ours and that of the annotation's own 6 mm band without its
+// outer 4 or 8 px, all against the annotation (rad): see osdRimMarkdown.
+struct OsdRimCheck
+{
+  double ours = 0.0;
+  double without_4px = 0.0;
+  double without_8px = 0.0;
+};
+
 struct OsdResults
 {
   std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
@@ -65,8 +74,12 @@ struct OsdResults
   // as modelled, independent per pixel), and its centroid's squared offset from the plane over
   // the model's centroid variance (median 0.455, chi^2 with 1 dof, for errors as modelled).
   std::vector<double> table_block_spread, table_centroid_chi2;
+  std::vector<OsdRimCheck> rim_checks;  // ours, single frame
 };
 
+// How far the annotation's normal moves without the faces' outer pixels, beside ours, as one
+// markdown line: the scale below which E_angle cannot tell methods apart on these frames.
+std::string osdRimMarkdown(const OsdResults& results);
 // The median of each of results' noise samples, as one markdown line.
 std::string osdNoiseMarkdown(const OsdResults& results);
 
