@@ -52,7 +52,16 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
     }
   }
   if (!best) return "no Hough peak";
-  if (best->verdict == CandidateVerdict::kAccepted) return "seen, not yet in the map";
+  if (best->verdict == CandidateVerdict::kAccepted)
+  {
+    // A map plane within the tolerance that the one-to-one matching gave to another true plane:
+    // the map holds the two surfaces as one plane.
+    for (const DetectedPlane& p : detector.planes())
+      if (angleError(p.normal, truth.normal) <= tolerance.angle &&
+          distanceError(p.normal, p.d, truth.normal, truth.d) <= tolerance.distance)
+        return "seen, one map plane with another surface";
+    return "seen, not yet in the map";
+  }
   return std::string(toString(best->verdict)) + (best->parallel_search ? " (parallel search)" : "");
 }
 
