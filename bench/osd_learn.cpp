@@ -136,6 +136,29 @@ std::string missReason(const PlaneDetector& detector, const Entry& entry)
   return reason;
 }
 
+// Least-squares normal of the masked pixels; false with fewer than min_pixels of them.
+bool maskedPlaneNormal(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<char>& mask, int min_pixels,
+                       Eigen::Vector3d& normal)
+{
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d squares = Eigen::Matrix3d::Zero();
+  int count = 0;
+  for (size_t i = 0; i < mask.size(); ++i)
+  {
+    if (!mask[i]) continue;
+    const pcl::PointXYZRGBL& q = cloud.points[i];
+    const Eigen::Vector3d x(q.x, q.y, q.z);
+    sum += x;
+    squares += x * x.transpose();
+    ++count;
+  }
+  if (count < min_pixels) return false;
+  const Eigen::Vector3d mean = sum / count;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(squares / count - mean * mean.transpose());
+  normal = solver.eigenvectors().col(0);
+  return true;
+}
+
 // For each found entry: our matching plane's error and that of the least-squares plane of
 // the pixels we label with it (the table anywhere, a face inside its box with a margin).
 void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::PointCloud<pcl::PointXYZRGBL>& cloud,
@@ -159,21 +182,15 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
       }
     if (!best) continue;
     int labelled = 0;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d squares = Eigen::Matrix3d::Zero();
+    std::vector<char> ours(labels.size(), 0);
     for (int v = 0; v < view.height; ++v)
       for (int u = 0; u < view.width; ++u)
       {
-        const pcl::PointXYZRGBL& q = cloud.at(u, v);
+        const size_t i = static_cast<size_t>(v) * view.width + u;
         const bool inside = e.object == 0 || (u >= e.box[0] - kMargin && u <= e.box[2] + kMargin &&
                                               v >= e.box[1] - kMargin && v <= e.box[3] + kMargin);
-        if (inside && std::isfinite(q.z) && labels[static_cast<size_t>(v) * view.width + u] == best->id)
-        {
-          const Eigen::Vector3d x(q.x, q.y, q.z);
-          ++labelled;
-          sum += x;
-          squares += x * x.transpose();
-        }
+        ours[i] = inside && std::isfinite(cloud.points[i].z) && labels[i] == best->id;
+        labelled += ours[i];
       }
     OsdFitError fit{frame, e.name, e.points, labelled};
     matches(best->normal, best->d, e, &fit.angle);
@@ -197,13 +214,9 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> info(across);
       fit.own_sigma = info.eigenvalues()(1) > 0.0 ? 1.0 / std::sqrt(info.eigenvalues()(1)) : 0.0;
     }
-    fit.labelled_fit_angle = M_PI / 2;
-    if (labelled >= 3)
-    {
-      const Eigen::Vector3d mean = sum / labelled;
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(squares / labelled - mean * mean.transpose());
-      fit.labelled_fit_angle = unsignedAngle(solver.eigenvectors().col(0), e.normal);
-    }
+    Eigen::Vector3d labelled_normal;
+    fit.labelled_fit_angle = maskedPlaneNormal(cloud, ours, 3, labelled_normal) ? unsignedAngle(labelled_normal, e.normal)
+                                                                                 : M_PI / 2;
     out.push_back(fit);
   }
 }
@@ -227,30 +240,6 @@ void tableNoise(const PlaneDetector& detector, const std::vector<Entry>& entries
       results.table_centroid_chi2.push_back(offset * offset / info.centroid_variance);
     }
   }
-}
-
-// Least-squares normal of the masked pixels; false with fewer than kMinPixels of them.
-bool maskedPlaneNormal(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<char>& mask,
-                       Eigen::Vector3d& normal)
-{
-  constexpr int kMinPixels = 100;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d squares = Eigen::Matrix3d::Zero();
-  int count = 0;
-  for (size_t i = 0; i < mask.size(); ++i)
-  {
-    if (!mask[i]) continue;
-    const pcl::PointXYZRGBL& q = cloud.points[i];
-    const Eigen::Vector3d x(q.x, q.y, q.z);
-    sum += x;
-    squares += x * x.transpose();
-    ++count;
-  }
-  if (count < kMinPixels) return false;
-  const Eigen::Vector3d mean = sum / count;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(squares / count - mean * mean.transpose());
-  normal = solver.eigenvectors().col(0);
-  return true;
 }
 
 // The mask without its outer `radius` pixels: a pixel stays when the (2 radius + 1)^2 square
@@ -282,6 +271,7 @@ void rimSensitivity(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::
 {
   constexpr double kBand = 0.006;        // m, the annotation's RANSAC distance
   constexpr double kReproduced = 0.005;  // rad: the band's own fit is the entry
+  constexpr int kMinPixels = 100;        // for a face's fit after erosion
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   for (size_t i = 0; i < entries.size(); ++i)
   {
@@ -295,9 +285,9 @@ void rimSensitivity(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::
                 std::abs(e.normal.dot(Eigen::Vector3d(q.x, q.y, q.z)) + e.d) <= kBand;
     }
     Eigen::Vector3d whole, without4, without8;
-    if (!maskedPlaneNormal(cloud, band, whole) || unsignedAngle(whole, e.normal) > kReproduced) continue;
-    if (!maskedPlaneNormal(cloud, erodeMask(band, width, height, 4), without4) ||
-        !maskedPlaneNormal(cloud, erodeMask(band, width, height, 8), without8))
+    if (!maskedPlaneNormal(cloud, band, kMinPixels, whole) || unsignedAngle(whole, e.normal) > kReproduced) continue;
+    if (!maskedPlaneNormal(cloud, erodeMask(band, width, height, 4), kMinPixels, without4) ||
+        !maskedPlaneNormal(cloud, erodeMask(band, width, height, 8), kMinPixels, without8))
       continue;
     results.rim_checks.push_back({our_angles[i], unsignedAngle(without4, e.normal), unsignedAngle(without8, e.normal)});
   }

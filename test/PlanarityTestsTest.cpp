@@ -46,10 +46,10 @@ TEST(PlanarityTests, TheLikelihoodRatioTellsTheTrueNormalFromOneDegreeOff)
   Frame f;
   const std::vector<int> wall = f.blocksOn(f.truePlane("wall"));
   const Eigen::Vector3d n_cam = f.frame.normalInCamera(f.renderer.truePlanes()[f.truePlane("wall")].normal);
-  EXPECT_TRUE(f.tests.explainedByNormal(n_cam, wall));
+  EXPECT_TRUE(f.tests.explainNormal(n_cam, wall, false).interior);
   const Eigen::Vector3d tilted = Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d::UnitX()) * n_cam;
   EXPECT_GT(f.tests.snapChi2Increase(tilted, wall), kMaxSnapChi2Increase);
-  EXPECT_FALSE(f.tests.explainedByNormal(tilted, wall));
+  EXPECT_FALSE(f.tests.explainNormal(tilted, wall, false).interior);
 }
 
 TEST(PlanarityTests, ANormalNeedsSpreadAcrossMoreThanAFewBlocks)

@@ -52,13 +52,9 @@ public:
   // `also`; moments of the rest.
   PointMoments keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
                                   const std::function<bool(const std::vector<int>&)>& also = nullptr) const;
-  // True when a plane of the camera-frame normal explains the blocks (their interior when it
+  // `interior`: a plane of the camera-frame normal explains the blocks (their interior when it
   // has kMinInteriorBlocks: rim blocks may straddle a fold) about as well as their own best
   // plane: a likelihood-ratio test, chi^2 increase below kMaxSnapChi2Increase.
-  bool explainedByNormal(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
-  {
-    return explainNormal(n_cam, blocks, false).interior;
-  }
   // The same test, and (`with_rim`, only when the interior passes) made again with the rim
   // blocks whose own normal is informative and within its tolerance of the plane's: one
   // straddling a fold would show the fold in its normal.
