@@ -44,53 +44,57 @@ PointMoments weightedCentroidMoments(const std::vector<BlockInfo>& info, const s
 void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
                     std::vector<BlockInfo>& info, ThreadTeam& team)
 {
-  const int bx_count = grid.blocksX(), count = grid.blocksX() * grid.blocksY();
-  info.resize(count);
-  const bool noise_aware = noise.enabled();
+  info.resize(static_cast<size_t>(grid.blocksX()) * grid.blocksY());
   // Each block is described on its own; a row of blocks is one item of the team's work.
-  team.forEach(grid.blocksY(), [&](int by, int) {
-    for (int b = by * bx_count; b < (by + 1) * bx_count; ++b)
-    {
-      const PointMoments& block = grid.block(b - by * bx_count, by);
-      BlockInfo& i = info[b];
-      i = BlockInfo();
-      i.valid = block.count >= 3;
-      if (!i.valid) continue;
-      i.centroid = block.mean();
-      i.ray = i.centroid.normalized();
-      i.covariance = block.covariance();
-      const double sigma = noise.sigma(i.centroid.z());
-      const double step = noise.quantizationStep(i.centroid.z());
-      // Quantization moves a block as a whole, so it does not average out over the block.
-      i.centroid_variance = sigma * sigma / block.count + step * step / 12.0;
-      // Around a fitted plane a centroid may stray by its noise and 1 cm of sensor warp.
-      i.tight_residual = noise_aware ? 0.01 + 3.0 * std::sqrt(i.centroid_variance) : params.support_distance;
-      i.thickness_limit = noise_aware ? 6.25 * sigma * sigma + 1e-4 : 0.25 * params.support_distance * params.support_distance;
-      i.fit_weight = 1.0 / (sigma * sigma + 1e-6);
-      i.weighted_centroid = centroidMoments(block);
-      i.weighted_centroid.scale(i.fit_weight);
-      const double systematic = kSystematicPerSquareMetre * i.centroid.z() * i.centroid.z();
-      const double block_sigma = std::max(kMinBlockSigma, sigma);
-      i.region_residual = 3.0 * std::sqrt(block_sigma * block_sigma / block.count + step * step / 12.0 + systematic * systematic);
-      if (!params.region_growing) continue;  // the windows' fit needs no block normals
-      const SmallestEigenpair eigen = smallestEigenpair(i.covariance);
-      i.normal = eigen.vector;
-      if (i.normal.dot(i.centroid) > 0.0) i.normal = -i.normal;
-      // Flat: thinner along its normal than three sigmas of the sensor's noise (an edge or a
-      // depth jump inside the block is thicker). Its normal is then good to sigma over its
-      // narrower half-width, per point.
-      const Eigen::Vector3d eigenvalues = eigen.values.cwiseMax(0.0);
-      i.planar = block.count >= 8 && (noise_aware ? eigenvalues(0) <= 9.0 * block_sigma * block_sigma : eigenvalues(0) <= i.thickness_limit);
-      // Where the block is as thick as half its width (noise far from a Kinect) its smallest
-      // eigenvector may lie in the surface: such a block is judged by its centroid alone. Both
-      // come from the block's own scatter, so a sensor quieter than the model is used as it is.
-      const double normal_sigma = std::sqrt(eigenvalues(0) / (std::max(1e-12, eigenvalues(1)) * block.count));
-      const bool normal_informative = eigenvalues(0) < kMaxThicknessRatio * eigenvalues(1);
-      i.normal_tolerance = normal_informative ? std::min(kMaxNormalTolerance, std::max(params.support_angle, 3.0 * normal_sigma))
-                                              : M_PI / 2;
-      i.normal_tolerance_cosine = std::cos(i.normal_tolerance);
-    }
-  });
+  team.forEach(grid.blocksY(), [&](int by, int) { describeBlockRow(grid, params, noise, by, info); });
+}
+
+void describeBlockRow(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise, int by,
+                      std::vector<BlockInfo>& info)
+{
+  const int bx_count = grid.blocksX();
+  const bool noise_aware = noise.enabled();
+  for (int b = by * bx_count; b < (by + 1) * bx_count; ++b)
+  {
+    const PointMoments& block = grid.block(b - by * bx_count, by);
+    BlockInfo& i = info[b];
+    i = BlockInfo();
+    i.valid = block.count >= 3;
+    if (!i.valid) continue;
+    i.centroid = block.mean();
+    i.ray = i.centroid.normalized();
+    i.covariance = block.covariance();
+    const double sigma = noise.sigma(i.centroid.z());
+    const double step = noise.quantizationStep(i.centroid.z());
+    // Quantization moves a block as a whole, so it does not average out over the block.
+    i.centroid_variance = sigma * sigma / block.count + step * step / 12.0;
+    // Around a fitted plane a centroid may stray by its noise and 1 cm of sensor warp.
+    i.tight_residual = noise_aware ? 0.01 + 3.0 * std::sqrt(i.centroid_variance) : params.support_distance;
+    i.thickness_limit = noise_aware ? 6.25 * sigma * sigma + 1e-4 : 0.25 * params.support_distance * params.support_distance;
+    i.fit_weight = 1.0 / (sigma * sigma + 1e-6);
+    i.weighted_centroid = centroidMoments(block);
+    i.weighted_centroid.scale(i.fit_weight);
+    const double systematic = kSystematicPerSquareMetre * i.centroid.z() * i.centroid.z();
+    const double block_sigma = std::max(kMinBlockSigma, sigma);
+    i.region_residual = 3.0 * std::sqrt(block_sigma * block_sigma / block.count + step * step / 12.0 + systematic * systematic);
+    if (!params.region_growing) continue;  // the windows' fit needs no block normals
+    const SmallestEigenpair eigen = smallestEigenpair(i.covariance);
+    i.normal = eigen.vector;
+    if (i.normal.dot(i.centroid) > 0.0) i.normal = -i.normal;
+    // Flat: thinner along its normal than three sigmas of the sensor's noise (an edge or a
+    // depth jump inside the block is thicker). Its normal is then good to sigma over its
+    // narrower half-width, per point.
+    const Eigen::Vector3d eigenvalues = eigen.values.cwiseMax(0.0);
+    i.planar = block.count >= 8 && (noise_aware ? eigenvalues(0) <= 9.0 * block_sigma * block_sigma : eigenvalues(0) <= i.thickness_limit);
+    // Where the block is as thick as half its width (noise far from a Kinect) its smallest
+    // eigenvector may lie in the surface: such a block is judged by its centroid alone. Both
+    // come from the block's own scatter, so a sensor quieter than the model is used as it is.
+    const double normal_sigma = std::sqrt(eigenvalues(0) / (std::max(1e-12, eigenvalues(1)) * block.count));
+    const bool normal_informative = eigenvalues(0) < kMaxThicknessRatio * eigenvalues(1);
+    i.normal_tolerance = normal_informative ? std::min(kMaxNormalTolerance, std::max(params.support_angle, 3.0 * normal_sigma))
+                                            : M_PI / 2;
+    i.normal_tolerance_cosine = std::cos(i.normal_tolerance);
+  }
 }
 
 BlockRegionGrower::BlockRegionGrower(const NormalEstimator& grid, const std::vector<BlockInfo>& info,

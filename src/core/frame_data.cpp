@@ -6,6 +6,13 @@ namespace hough_plane_detector
 void FrameData::measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
                         const DepthNoiseModel& sensor_noise, ThreadTeam& team)
 {
+  measureWindows(cloud, pose, params, sensor_noise, team);
+  describeBlocks(normals, params, noise, blocks, team);
+}
+
+void FrameData::measureWindows(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
+                               const DepthNoiseModel& sensor_noise, ThreadTeam& team)
+{
   camera_to_world = pose;
   noise = sensor_noise;
   NormalEstimatorConfig config;
@@ -16,7 +23,6 @@ void FrameData::measure(const CloudView& cloud, const Eigen::Isometry3d& pose, c
   config.noise = noise;
   config.max_window_scale = params.max_window_scale;
   normals.compute(cloud, camera_to_world, config, samples, team);
-  describeBlocks(normals, params, noise, blocks, team);
   block_claim.clear();
 }
 

@@ -104,32 +104,51 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
     ms = msSince(start);
   };
   timed(timings_.normals_ms, [&] { estimateNormals(cloud); });
-  timed(timings_.voting_ms, [&] {
-    // One vote per window weighted by its points over the window overlap.
-    const float overlap = static_cast<float>(params_.normal_stride * params_.normal_stride) /
-                          static_cast<float>(params_.normal_window * params_.normal_window);
-    stats_.votes_out_of_range = voting_.vote(frame_.samples, overlap, local_);
-    stats_.cache_cells = static_cast<int>(voting_.cache().size());
-  });
-  timed(timings_.blur_ms, [&] { voting_.blur(local_); });
+  // Stages that read disjoint data share the team: the blocks' statistics (row by row) beside
+  // voting, blur and peaks (one item), then the evidence check beside the fits.
   std::vector<HoughPeak> peaks;
-  timed(timings_.peaks_ms, [&] { findLocalPeaks(peaks); });
+  frame_.sizeBlocks();
+  timed(timings_.blocks_ms, [&] {
+    measurement_team_->forEach(1 + frame_.blocksY(), [&](int item, int) {
+      if (item > 0)
+      {
+        frame_.describeBlockRow(params_, item - 1);
+        return;
+      }
+      timed(timings_.voting_ms, [&] {
+        // One vote per window weighted by its points over the window overlap.
+        const float overlap = static_cast<float>(params_.normal_stride * params_.normal_stride) /
+                              static_cast<float>(params_.normal_window * params_.normal_window);
+        stats_.votes_out_of_range = voting_.vote(frame_.samples, overlap, local_);
+        stats_.cache_cells = static_cast<int>(voting_.cache().size());
+      });
+      timed(timings_.blur_ms, [&] { voting_.blur(local_); });
+      timed(timings_.peaks_ms, [&] { findLocalPeaks(peaks); });
+    });
+  });
   frame_planes_.clear();
   candidates_.clear();
-  timed(timings_.fit_ms, [&] {
-    if (params_.region_growing)
-      fitter_.growRegions(peaks, map_.planes(), frame_planes_, candidates_);
-    else
-      fitter_.fitWindows(peaks, map_.planes(), frame_planes_, candidates_);
-  });
-  timed(timings_.parallel_ms, [&] {
-    findParallelPlanes(params_, param_, frame_, tests_, map_.planes(), frame_planes_, candidates_);
+  measurement_team_->forEach(2, [&](int item, int) {
+    if (item == 1)
+    {
+      timed(timings_.evidence_ms, [&] {
+        if (params_.forgetting == kForgetByEvidence)
+          map_.checkEvidence(cloud, camera_to_world, intrinsics_, frame_.noise);
+      });
+      return;
+    }
+    timed(timings_.fit_ms, [&] {
+      if (params_.region_growing)
+        fitter_.growRegions(peaks, map_.planes(), frame_planes_, candidates_);
+      else
+        fitter_.fitWindows(peaks, map_.planes(), frame_planes_, candidates_);
+    });
+    timed(timings_.parallel_ms, [&] {
+      findParallelPlanes(params_, param_, frame_, tests_, map_.planes(), frame_planes_, candidates_);
+    });
   });
   // No merge of the frame's planes: greedy claiming leaves a peak's mirrored twin or echo nothing.
   stats_.local_peaks = static_cast<int>(frame_planes_.size());
-  timed(timings_.evidence_ms, [&] {
-    if (params_.forgetting == kForgetByEvidence) map_.checkEvidence(cloud, camera_to_world, intrinsics_, frame_.noise);
-  });
   timed(timings_.global_ms, [&] {
     stats_.chunks_evicted = map_.accumulate(frame_planes_, camera_to_world.translation(), stamp);
   });
@@ -151,8 +170,8 @@ void PlaneDetector::estimateNormals(const CloudView& cloud)
     intrinsics_ = intrinsics;
     focal_length_ = intrinsics.fx * 640.0 / cloud.width;
   }
-  frame_.measure(cloud, frame_.camera_to_world, params_,
-                 DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_), *measurement_team_);
+  frame_.measureWindows(cloud, frame_.camera_to_world, params_,
+                        DepthNoiseModel(params_.sensor_model, params_.sensor_noise, focal_length_), *measurement_team_);
   stats_.windows_valid = frame_.normals.validWindows();
   stats_.samples = static_cast<int>(frame_.samples.size());
 }

@@ -52,6 +52,9 @@ struct BlockInfo
 // its rows of blocks shared out over `team` (each block is described on its own).
 void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
                     std::vector<BlockInfo>& info, ThreadTeam& team = ThreadTeam::callingThreadOnly());
+// One row of blocks of that work, into `info` already sized to the grid.
+void describeBlockRow(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise, int by,
+                      std::vector<BlockInfo>& info);
 
 // Calls visit(neighbour) for each 4-neighbour of block b inside a bx_count x by_count grid.
 template <class Visit>

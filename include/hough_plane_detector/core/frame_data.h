@@ -31,6 +31,15 @@ struct FrameData
   // Blocks and windows are shared out over `team`'s threads (the same result for any number).
   void measure(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
                const DepthNoiseModel& sensor_noise, ThreadTeam& team = ThreadTeam::callingThreadOnly());
+  // measure() in steps, for a caller that shares the blocks' rows out with other work: the
+  // windows (samples, block sums), then the blocks sized, then each row's statistics.
+  void measureWindows(const CloudView& cloud, const Eigen::Isometry3d& pose, const DetectorParams& params,
+                      const DepthNoiseModel& sensor_noise, ThreadTeam& team);
+  void sizeBlocks() { blocks.resize(static_cast<size_t>(blocksX()) * blocksY()); }
+  void describeBlockRow(const DetectorParams& params, int row)
+  {
+    hough_plane_detector::describeBlockRow(normals, params, noise, row, blocks);
+  }
 
   int blocksX() const { return normals.blocksX(); }
   int blocksY() const { return normals.blocksY(); }

@@ -39,13 +39,14 @@ namespace hough_plane_detector
 
 struct StageTimings
 {
-  double normals_ms = 0;   // windows' normals and the blocks' statistics
+  double normals_ms = 0;   // windows' normals and the blocks' sums
+  double blocks_ms = 0;    // the blocks' statistics with voting, blur and peaks beside them (wall time of the four)
   double voting_ms = 0;    // cache space
   double blur_ms = 0;      // local space
   double peaks_ms = 0;     // local peaks
   double fit_ms = 0;       // per-frame planes from the peaks (windows or block regions)
   double parallel_ms = 0;  // the parallel-plane search
-  double evidence_ms = 0;  // forgetting by evidence: the map's planes checked against the frame
+  double evidence_ms = 0;  // forgetting by evidence: the map's planes checked against the frame (beside the fits)
   double global_ms = 0;    // the map: thinning, accumulation, global peaks, ids
   double labels_ms = 0;    // the frame's labels, support and extents
   double total_ms = 0;
