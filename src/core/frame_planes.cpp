@@ -475,7 +475,9 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
   // components kept.
   const double min_points = std::max(3, params_.min_support);
   if (region.points < min_points) return CandidateVerdict::kTooFewPoints;
-  if ((moments = tests_.keepFlatComponents(region.blocks, params_.merge_angle, 1)).count < min_points)
+  int flat_patches = 0;
+  if ((moments = tests_.keepFlatComponents(region.blocks, params_.merge_angle, 1, nullptr, &flat_patches)).count <
+      min_points)
     return CandidateVerdict::kCurvedPatches;
   if (!grower.fit(region.blocks, region.normal, region.d)) return CandidateVerdict::kTooFewPoints;
   if (grower.seenEdgeOn(region.blocks, region.normal)) return CandidateVerdict::kEdgeOn;
@@ -483,7 +485,8 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
     return CandidateVerdict::kCurvedPatches;
   if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
     return CandidateVerdict::kCentroidsOffPlane;
-  if (!tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
+  // One patch left has passed this very test (the same blocks in the same order) just above.
+  if (flat_patches > 1 && !tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
     return CandidateVerdict::kHalvesDisagree;
   return CandidateVerdict::kAccepted;
 }

@@ -160,8 +160,10 @@ PointMoments PlanarityTests::weightedMoments(const std::vector<int>& blocks) con
 }
 
 PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
-                                               const std::function<bool(const std::vector<int>&)>& also) const
+                                               const std::function<bool(const std::vector<int>&)>& also,
+                                               int* kept_count) const
 {
+  if (kept_count) *kept_count = 0;
   // Two pillars can share a tangent plane: each connected patch of the support must be flat
   // on its own; curved patches are dropped, tiny ones too (they cannot be tested).
   constexpr size_t kMinComponentBlocks = 4;
@@ -177,7 +179,10 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
     const bool wide_enough = x_max - x_min + 1 >= min_span && y_max - y_min + 1 >= min_span;
     if (component.size() >= kMinComponentBlocks && wide_enough && halvesAgree(component, 0, component.size(), max_angle) &&
         (!also || also(component)))
+    {
       kept.insert(kept.end(), component.begin(), component.end());
+      if (kept_count) ++*kept_count;
+    }
   });
   blocks.swap(kept);
   PointMoments moments;

@@ -49,9 +49,10 @@ public:
   bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const;
   // Drops the connected patches of `blocks` that are tiny, narrower than min_span blocks
   // across the image, whose halves tilt apart by more than max_angle (curved) or that fail
-  // `also`; moments of the rest.
+  // `also`; moments of the rest, and in `kept` how many patches are left.
   PointMoments keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
-                                  const std::function<bool(const std::vector<int>&)>& also = nullptr) const;
+                                  const std::function<bool(const std::vector<int>&)>& also = nullptr,
+                                  int* kept = nullptr) const;
   // `interior`: a plane of the camera-frame normal explains the blocks (their interior when it
   // has kMinInteriorBlocks: rim blocks may straddle a fold) about as well as their own best
   // plane: a likelihood-ratio test, chi^2 increase below kMaxSnapChi2Increase.
