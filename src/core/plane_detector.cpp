@@ -1,6 +1,7 @@
 #include "hough_plane_detector/core/plane_detector.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -105,25 +106,31 @@ bool PlaneDetector::processFrame(const CloudView& cloud, const Eigen::Isometry3d
   };
   timed(timings_.normals_ms, [&] { estimateNormals(cloud); });
   // Stages that read disjoint data share the team: the blocks' statistics (row by row) beside
-  // voting, blur and peaks (one item), then the evidence check beside the fits.
+  // voting, blur and peaks, then the evidence check beside the fits. A helper takes the Hough
+  // stages, so that the blocks the fits read next are mostly described in the caller's cache.
   std::vector<HoughPeak> peaks;
   frame_.sizeBlocks();
+  std::atomic<int> next_row{0};
+  std::atomic<bool> hough_taken{false};
+  auto describeRows = [&] {
+    for (int row = next_row++; row < frame_.blocksY(); row = next_row++) frame_.describeBlockRow(params_, row);
+  };
+  auto houghStages = [&] {
+    timed(timings_.voting_ms, [&] {
+      // One vote per window weighted by its points over the window overlap.
+      const float overlap = static_cast<float>(params_.normal_stride * params_.normal_stride) /
+                            static_cast<float>(params_.normal_window * params_.normal_window);
+      stats_.votes_out_of_range = voting_.vote(frame_.samples, overlap, local_);
+      stats_.cache_cells = static_cast<int>(voting_.cache().size());
+    });
+    timed(timings_.blur_ms, [&] { voting_.blur(local_); });
+    timed(timings_.peaks_ms, [&] { findLocalPeaks(peaks); });
+  };
   timed(timings_.blocks_ms, [&] {
-    measurement_team_->forEach(1 + frame_.blocksY(), [&](int item, int) {
-      if (item > 0)
-      {
-        frame_.describeBlockRow(params_, item - 1);
-        return;
-      }
-      timed(timings_.voting_ms, [&] {
-        // One vote per window weighted by its points over the window overlap.
-        const float overlap = static_cast<float>(params_.normal_stride * params_.normal_stride) /
-                              static_cast<float>(params_.normal_window * params_.normal_window);
-        stats_.votes_out_of_range = voting_.vote(frame_.samples, overlap, local_);
-        stats_.cache_cells = static_cast<int>(voting_.cache().size());
-      });
-      timed(timings_.blur_ms, [&] { voting_.blur(local_); });
-      timed(timings_.peaks_ms, [&] { findLocalPeaks(peaks); });
+    // The caller alone takes both items in turn: the second then runs the Hough stages.
+    measurement_team_->forEach(2, [&](int item, int member) {
+      if ((member != 0 || item == 1) && !hough_taken.exchange(true)) houghStages();
+      describeRows();
     });
   });
   frame_planes_.clear();
