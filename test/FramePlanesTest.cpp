@@ -229,3 +229,43 @@ TEST(FramePlaneFitter, ARegionOverTwoFacesThatCrossMidwayIsFlaggedAsMixing)
   EXPECT_TRUE(backs->mixes_surfaces);
   EXPECT_FALSE(backs->fits_its_blocks);
 }
+
+// A wall of which only two block rows, 16 blocks long, are measured flat (the rest as if
+// cluttered): its points cannot orient it, so without the world's up it is refused; with it
+// (world_z_up) it is the upright plane through them, the wall's.
+TEST(FramePlaneFitter, AnUnorientedStripIsKeptUprightWhenTheWorldsUpIsKnown)
+{
+  for (int world_z_up = 0; world_z_up <= 1; ++world_z_up)
+  {
+    Frame f;
+    f.params.world_z_up = world_z_up;
+    const TruePlane& wall = f.renderer.truePlanes()[f.truePlane("wall")];
+    const std::vector<int> wall_blocks = f.blocksOn(f.truePlane("wall"));
+    const int row = f.wallRow(wall_blocks), column = f.frame.blocksX() / 2;
+    for (size_t b = 0; b < f.frame.blocks.size(); ++b)
+    {
+      const int by = static_cast<int>(b) / f.frame.blocksX(), bx = static_cast<int>(b) % f.frame.blocksX();
+      if (by < row || by > row + 1 || bx < column - 8 || bx >= column + 8) f.frame.blocks[b].planar = false;
+    }
+    FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
+    std::vector<FramePlane> planes;
+    std::vector<PlaneCandidate> candidates;
+    fitter.growRegions({f.peakOf(wall)}, {}, planes, candidates);
+    SCOPED_TRACE(world_z_up ? "world_z_up 1" : "world_z_up 0");
+    ASSERT_FALSE(candidates.empty());
+    const PlaneCandidate& first = candidates.front();
+    if (!world_z_up)
+    {
+      EXPECT_EQ(first.verdict, CandidateVerdict::kNormalUndetermined);
+      EXPECT_TRUE(planes.empty());
+      continue;
+    }
+    EXPECT_EQ(first.verdict, CandidateVerdict::kAccepted);
+    ASSERT_EQ(planes.size(), 1u);
+    EXPECT_TRUE(planes[0].upright);
+    EXPECT_EQ(planes[0].normal.z(), 0.0);
+    EXPECT_LT(angleBetween(planes[0].normal, wall.normal), 0.01);
+    EXPECT_LT(planes[0].normal_sigma, f.params.merge_angle / 2.0);
+    EXPECT_LT(std::abs(std::abs(planes[0].d) - std::abs(wall.d)), 0.01);
+  }
+}

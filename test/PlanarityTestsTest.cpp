@@ -77,3 +77,33 @@ TEST(PlanarityTests, ANormalNeedsSpreadAcrossMoreThanAFewBlocks)
     if (b / f.frame.blocksX() == row + 1 || b / f.frame.blocksX() == row + 2) strip.push_back(b);
   EXPECT_LT(f.tests.normalUncertainty(strip), bound);
 }
+
+TEST(PlanarityTests, AnUnorientedStripOfAWallFitsUprightALevelPatchDoesNot)
+{
+  Frame f;
+  const std::vector<int> wall = f.blocksOn(f.truePlane("wall"));
+  const double bound = f.params.merge_angle / 2.0;  // FramePlaneFitter's limit
+  const Eigen::Vector3d up = f.frame.normalInCamera(Eigen::Vector3d::UnitZ());
+  // One image row of the wall: its own points fix no tilt about the row (see above), but
+  // among upright planes only the wall's contains it.
+  const int row = f.wallRow(wall);
+  std::vector<int> strip;
+  for (int b : wall)
+    if (b / f.frame.blocksX() == row) strip.push_back(b);
+  ASSERT_GT(f.tests.normalUncertainty(strip), bound);
+  Eigen::Vector3d n_cam;
+  double d_cam = 0.0, sigma = 0.0;
+  ASSERT_TRUE(f.tests.uprightNormal(strip, up, n_cam, d_cam, sigma));
+  const TruePlane& truth = f.renderer.truePlanes()[f.truePlane("wall")];
+  EXPECT_LT(angleBetween(f.frame.normalInWorld(n_cam), truth.normal), 0.01);
+  EXPECT_NEAR(std::abs(n_cam.dot(up)), 0.0, 1e-12);
+  EXPECT_LT(sigma, bound);
+  // A patch of the floor, three block rows deep, lies on no upright plane.
+  const std::vector<int> floor = f.blocksOn(f.truePlane("floor"));
+  const int floor_row = f.wallRow(floor);
+  std::vector<int> patch;
+  for (int b : floor)
+    if (std::abs(b / f.frame.blocksX() - floor_row) <= 1) patch.push_back(b);
+  ASSERT_GT(patch.size(), 30u);
+  EXPECT_FALSE(f.tests.uprightNormal(patch, up, n_cam, d_cam, sigma));
+}

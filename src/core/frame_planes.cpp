@@ -194,8 +194,10 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     const bool snapped = verdict == CandidateVerdict::kAccepted &&
                          snapToKnownDirection(normal, d, region.blocks, map_planes, planes, &snap_blocks);
     // Computed once: the orientation test and the accepted plane's record both need it.
-    const double normal_sigma = verdict == CandidateVerdict::kAccepted ? tests_.normalUncertainty(region.blocks) : 0.0;
-    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(normal_sigma))
+    double normal_sigma = verdict == CandidateVerdict::kAccepted ? tests_.normalUncertainty(region.blocks) : 0.0;
+    bool upright = false;
+    if (verdict == CandidateVerdict::kAccepted && !snapped && !normalDetermined(normal_sigma) &&
+        !(upright = uprightFace(region.blocks, normal, d, normal_sigma)))
       verdict = CandidateVerdict::kNormalUndetermined;
     candidates.push_back({normal, d, peak_value, std::max(region.points, moments.count), verdict});
     // A region on one surface that its points cannot orient keeps its blocks from the next
@@ -206,7 +208,7 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     for (int b : region.blocks) frame_.block_claim[b] = 1;
     // A snapped plane is measured by the blocks on it, not by the rim blocks whose lean it undid.
     planes.push_back(regionPlane(normal, d, peak_value, moments.count, snapped, region.blocks, normal_sigma,
-                                 snapped ? snap_blocks : region.blocks));
+                                 snapped ? snap_blocks : region.blocks, upright));
     if (snapped) recordOwnNormal(planes.back(), snap_blocks);
     split_group_.push_back(split_group);
   };
@@ -269,9 +271,10 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
 
 FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d, double value, double support,
                                          bool parallel, const std::vector<int>& blocks, double normal_sigma,
-                                         const std::vector<int>& measured_by) const
+                                         const std::vector<int>& measured_by, bool upright) const
 {
   FramePlane plane;
+  plane.upright = upright;
   plane.normal = normal;
   plane.d = d;
   plane.hough = param_.toHough(normal, d);
@@ -304,6 +307,13 @@ void FramePlaneFitter::testFitToBlocks(FramePlane& plane, const std::vector<int>
   if (interior.size() < kMinInteriorBlocks) return;
   Eigen::Vector3d interior_normal;
   if (!tests_.weightedMoments(interior).planeNormal(interior_normal)) return;
+  // An upright plane's sigma is of its turn about the vertical: the interior is judged on that
+  // turn (that it fits upright at all, uprightFace has tested).
+  if (plane.upright)
+  {
+    const Eigen::Vector3d up = frame_.normalInCamera(Eigen::Vector3d::UnitZ());
+    interior_normal = (interior_normal - up * up.dot(interior_normal)).normalized();
+  }
   plane.fits_its_blocks = unsignedAngle(interior_normal, n_cam) <= 3.0 * plane.normal_sigma;
 }
 
@@ -489,6 +499,26 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
   if (flat_patches > 1 && !tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
     return CandidateVerdict::kHalvesDisagree;
   return CandidateVerdict::kAccepted;
+}
+
+bool FramePlaneFitter::uprightFace(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d,
+                                   double& normal_sigma) const
+{
+  // With the world's up known, gravity stands walls, doors and the sides of boxes upright: a
+  // face its points leave unoriented but that fits an upright plane has one angle left to
+  // measure, its turn about the vertical.
+  if (!params_.world_z_up) return false;
+  Eigen::Vector3d n_cam;
+  double d_cam = 0.0, sigma = 0.0;
+  if (!tests_.uprightNormal(blocks, frame_.normalInCamera(Eigen::Vector3d::UnitZ()), n_cam, d_cam, sigma) ||
+      !normalDetermined(sigma))
+    return false;
+  normal = frame_.normalInWorld(n_cam);
+  normal.z() = 0.0;  // upright to the last bit, as the snap's level normals are level
+  normal.normalize();
+  d = frame_.dInWorld(normal, d_cam);
+  normal_sigma = sigma;
+  return true;
 }
 
 bool FramePlaneFitter::normalDetermined(double normal_sigma) const

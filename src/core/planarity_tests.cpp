@@ -107,38 +107,70 @@ double PlanarityTests::normalUncertainty(const std::vector<int>& blocks) const
 {
   // Each centroid weighted by the inverse of its own variance (quantization and systematic
   // error included: they do not average out within a block).
-  PointMoments moments;
-  std::vector<double> weights;
-  weights.reserve(blocks.size());
-  for (int b : blocks)
-  {
-    const double weight = 1.0 / (frame_.blocks[b].centroid_variance + kCentroidFloor);
-    PointMoments m = centroidMoments(frame_.moments(b));
-    weights.push_back(m.count > 0.0 ? weight : 0.0);
-    if (m.count <= 0.0) continue;
-    m.scale(weight / m.count);
-    moments.add(m);
-  }
+  const PointMoments moments = noiseWeightedCentroids(blocks);
   if (blocks.size() < 3 || moments.count <= 0.0) return M_PI / 2;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(moments.covariance());
-  // The tilt about the long axis is fixed by the spread across it (the middle axis). That
-  // must not hinge on a few blocks (a row along a shelf's edge and two off it, on the wall):
-  // the most informative tenth, at least two, is left out.
-  const Eigen::Vector3d across = solver.eigenvectors().col(1);
-  const Eigen::Vector3d mean = moments.mean();
+  // The tilt about the long axis is fixed by the spread across it (the middle axis).
+  return tiltUncertainty(blocks, moments.mean(), solver.eigenvectors().col(1));
+}
+
+double PlanarityTests::tiltUncertaintyAbout(const std::vector<int>& blocks, const Eigen::Vector3d& axis) const
+{
+  const PointMoments moments = noiseWeightedCentroids(blocks);
+  if (blocks.size() < 3 || moments.count <= 0.0) return M_PI / 2;
+  return tiltUncertainty(blocks, moments.mean(), axis);
+}
+
+double PlanarityTests::tiltUncertainty(const std::vector<int>& blocks, const Eigen::Vector3d& mean,
+                                       const Eigen::Vector3d& axis) const
+{
+  // That must not hinge on a few blocks (a row along a shelf's edge and two off it, on the
+  // wall): the most informative tenth, at least two, is left out.
   std::vector<double> information;
   information.reserve(blocks.size());
-  for (size_t i = 0; i < blocks.size(); ++i)
+  for (int b : blocks)
   {
-    const double x = across.dot(frame_.blocks[blocks[i]].centroid - mean);
-    information.push_back(weights[i] * x * x);
+    const BlockInfo& info = frame_.blocks[b];
+    const double weight = frame_.points(b) > 0.0 ? 1.0 / (info.centroid_variance + kCentroidFloor) : 0.0;
+    const double x = axis.dot(info.centroid - mean);
+    information.push_back(weight * x * x);
   }
   const size_t left_out = std::min(information.size() - 1, std::max<size_t>(2, information.size() / 10));
   std::nth_element(information.begin(), information.begin() + left_out, information.end(), std::greater<double>());
   double kept = 0.0;
   for (size_t i = left_out; i < information.size(); ++i) kept += information[i];
   return kept > 0.0 ? std::min(M_PI / 2, 1.0 / std::sqrt(kept)) : M_PI / 2;
+}
+
+bool PlanarityTests::uprightNormal(const std::vector<int>& blocks, const Eigen::Vector3d& up, Eigen::Vector3d& n_cam,
+                                   double& d_cam, double& sigma) const
+{
+  const PointMoments moments = noiseWeightedCentroids(blocks);
+  if (blocks.size() < 3 || moments.count <= 0.0) return false;
+  const Eigen::Matrix3d scatter = moments.covariance();
+  // The turn the points leave free is about their long axis: the constraint fixes it only when
+  // that axis is nearer level than upright (a band of a wall, a box face seen far off); along
+  // a tall strip (a pillar's side) it is the turn about the vertical, which stays free.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axes;
+  axes.computeDirect(scatter);
+  if (std::abs(axes.eigenvectors().col(2).dot(up)) > M_SQRT1_2) return false;
+  // The best plane among those whose normal lies in the level plane spanned by e1 and e2.
+  const Eigen::Vector3d e1 = up.unitOrthogonal(), e2 = up.cross(e1).normalized();
+  Eigen::Matrix2d level;
+  level << e1.dot(scatter * e1), e1.dot(scatter * e2), e2.dot(scatter * e1), e2.dot(scatter * e2);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver;
+  solver.computeDirect(level);
+  const Eigen::Vector2d smallest = solver.eigenvectors().col(0);
+  n_cam = (smallest.x() * e1 + smallest.y() * e2).normalized();
+  const Eigen::Vector3d mean = moments.mean();
+  if (n_cam.dot(mean) > 0.0) n_cam = -n_cam;  // toward the sensor at the origin
+  d_cam = -n_cam.dot(mean);
+  // All blocks: an interior may be one row, which any plane through it fits.
+  if (snapChi2(n_cam, blocks).fixed / static_cast<double>(blocks.size()) > noiseBoundOfMeanChi2(blocks.size()))
+    return false;
+  sigma = tiltUncertainty(blocks, mean, up.cross(n_cam).normalized());
+  return true;
 }
 
 double PlanarityTests::firstSightPoints(const std::vector<int>& blocks) const

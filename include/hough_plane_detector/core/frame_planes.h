@@ -57,6 +57,7 @@ struct FramePlane
   double offset_sigma = 0.0;
   // The standard error of its normal (rad) from its blocks; 0 when unknown.
   double normal_sigma = 0.0;
+  bool upright = false;  // its normal constrained level (FramePlaneFitter::uprightFace): normal_sigma is its turn about the vertical
   // Its blocks lie on it within their noise and its interior's own plane agrees with it: a
   // region leaning over a fold or a curve fails (the first-sight report, plane_map.cpp). A
   // snapped plane is judged on the blocks the snap measured it with.
@@ -126,13 +127,16 @@ private:
   // Its fit is tested on `measured_by`: the blocks, or for a snapped plane the snap's.
   FramePlane regionPlane(const Eigen::Vector3d& normal, double d, double value, double support, bool parallel,
                          const std::vector<int>& blocks, double normal_sigma,
-                         const std::vector<int>& measured_by) const;
+                         const std::vector<int>& measured_by, bool upright = false) const;
   // Joins touching regions of this frame that the region tests accept as one plane, but not the
   // two parts of a split region (split_group_).
   void mergeTouchingRegions(const BlockRegionGrower& grower, std::vector<FramePlane>& planes);
   // True when the normal's standard error (normalUncertainty of the blocks) is at most
   // merge_angle / 2: within merge_angle at two sigmas.
   bool normalDetermined(double normal_sigma) const;
+  // A face of undetermined normal refitted upright (world_z_up): its world plane and the
+  // uncertainty of its turn about the vertical, when it fits upright and that turn is determined.
+  bool uprightFace(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d, double& normal_sigma) const;
   // The normal of a known plane (the map's, or this frame's) within snap_angle of `normal`: of
   // the closest in angle that passes within merge_distance of `centroid` (world frame), the
   // piece's, if any, else of the closest; nullptr when none is within snap_angle.
