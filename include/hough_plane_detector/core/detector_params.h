@@ -123,8 +123,9 @@ struct DetectorParams
   // 1: the world frame's +z points up (REP 103: odom, map). A region (or a parallel-search
   // cluster) then takes a known normal more than 26 deg off the vertical only if its points'
   // own scatter, not just the noise model, cannot tell the two apart (an F test): level
-  // surfaces are parallel by gravity, box faces at any yaw only by chance. 0: up is unknown (a
-  // PCD in its camera's frame), every snap is judged by the noise model alone.
+  // surfaces are parallel by gravity, box faces at any yaw only by chance; and a region whose
+  // points cannot orient it may be kept upright (FramePlaneFitter::uprightFace). 0: up is
+  // unknown (a PCD in its camera's frame), every snap is judged by the noise model alone.
   int world_z_up = 1;
   // Per-frame planes: 1 = each Hough peak seeds regions of 8 x 8 pixel blocks grown while they
   // lie on the refitted plane within the sensor's noise, then the flat blocks left seed regions
