@@ -115,13 +115,6 @@ double PlanarityTests::normalUncertainty(const std::vector<int>& blocks) const
   return tiltUncertainty(blocks, moments.mean(), solver.eigenvectors().col(1));
 }
 
-double PlanarityTests::tiltUncertaintyAbout(const std::vector<int>& blocks, const Eigen::Vector3d& axis) const
-{
-  const PointMoments moments = noiseWeightedCentroids(blocks);
-  if (blocks.size() < 3 || moments.count <= 0.0) return M_PI / 2;
-  return tiltUncertainty(blocks, moments.mean(), axis);
-}
-
 double PlanarityTests::tiltUncertainty(const std::vector<int>& blocks, const Eigen::Vector3d& mean,
                                        const Eigen::Vector3d& axis) const
 {
@@ -281,6 +274,7 @@ PointMoments PlanarityTests::noiseWeightedCentroids(const std::vector<int>& bloc
   for (int b : blocks)
   {
     PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
+    if (m.count <= 0.0) continue;  // an empty block has no centroid
     const double weight = 1.0 / (frame_.blocks[b].centroid_variance + kCentroidFloor);
     m.scale(weight / m.count);
     sum.add(m);

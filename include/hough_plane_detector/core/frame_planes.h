@@ -57,7 +57,9 @@ struct FramePlane
   double offset_sigma = 0.0;
   // The standard error of its normal (rad) from its blocks; 0 when unknown.
   double normal_sigma = 0.0;
-  bool upright = false;  // its normal constrained level (FramePlaneFitter::uprightFace): normal_sigma is its turn about the vertical
+  // Its normal was constrained level (FramePlaneFitter::uprightFace): normal_sigma is then the
+  // standard error of its turn about the vertical.
+  bool upright = false;
   // Its blocks lie on it within their noise and its interior's own plane agrees with it: a
   // region leaning over a fold or a curve fails (the first-sight report, plane_map.cpp). A
   // snapped plane is judged on the blocks the snap measured it with.

@@ -111,16 +111,14 @@ public:
   // sure of: 1 / sqrt(sum of w x^2) over the weighted centroids' spread across that axis. A
   // strip of blocks along one image row fixes no tilt about its own length.
   double normalUncertainty(const std::vector<int>& blocks) const;
-  // The same about a given camera-frame axis in the plane: the turn the centroids' spread
-  // across it fixes (the most informative tenth left out, as above).
-  double tiltUncertaintyAbout(const std::vector<int>& blocks, const Eigen::Vector3d& axis) const;
   // A face whose points cannot orient it, constrained to stand upright (walls, doors, the
   // sides of boxes standing on a floor): the blocks' best plane whose normal is perpendicular
-  // to the camera-frame `up`, toward the sensor, when their long axis is nearer level than
-  // upright (the turn they leave free is then the one the constraint fixes) and they lie on it within their noise (mean
-  // chi^2 within noiseBoundOfMeanChi2; not against their own best plane, which for a row of
-  // blocks is the plane through the sensor that depth errors along the rays leave them on),
-  // with the uncertainty of its one free angle, the turn about the vertical. False otherwise.
+  // to the camera-frame `up`, toward the sensor, with the uncertainty of its one free angle,
+  // the turn about the vertical. Only when their long axis is nearer level than upright (the
+  // turn they leave free is then the one the constraint fixes) and they lie on that plane
+  // within their noise (mean chi^2 within noiseBoundOfMeanChi2; not against their own best
+  // plane, which for a row of blocks is the plane through the sensor that depth errors along
+  // the rays leave them on). False otherwise.
   bool uprightNormal(const std::vector<int>& blocks, const Eigen::Vector3d& up, Eigen::Vector3d& n_cam, double& d_cam,
                      double& sigma) const;
   // The blocks' points, each nearer than kStrongSupportDepth counted (sigma there / sigma at
@@ -132,7 +130,8 @@ public:
 private:
   // Moments of the block centroids, each weighted by its inverse centroid variance (count: the weight sum).
   PointMoments noiseWeightedCentroids(const std::vector<int>& blocks) const;
-  // tiltUncertaintyAbout with the centroids' weighted mean given.
+  // The standard error (rad) of a plane's turn that the weighted centroids' spread along
+  // `axis` (in the plane) fixes, about their weighted `mean`; the most informative tenth left out.
   double tiltUncertainty(const std::vector<int>& blocks, const Eigen::Vector3d& mean, const Eigen::Vector3d& axis) const;
 
   const DetectorParams& params_;
