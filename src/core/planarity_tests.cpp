@@ -125,7 +125,7 @@ double PlanarityTests::tiltUncertainty(const std::vector<int>& blocks, const Eig
   for (int b : blocks)
   {
     const BlockInfo& info = frame_.blocks[b];
-    const double weight = frame_.points(b) > 0.0 ? 1.0 / (info.centroid_variance + kCentroidFloor) : 0.0;
+    const double weight = frame_.points(b) > 0.0 ? centroidWeight(b) : 0.0;
     const double x = axis.dot(info.centroid - mean);
     information.push_back(weight * x * x);
   }
@@ -275,8 +275,7 @@ PointMoments PlanarityTests::noiseWeightedCentroids(const std::vector<int>& bloc
   {
     PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
     if (m.count <= 0.0) continue;  // an empty block has no centroid
-    const double weight = 1.0 / (frame_.blocks[b].centroid_variance + kCentroidFloor);
-    m.scale(weight / m.count);
+    m.scale(centroidWeight(b) / m.count);
     sum.add(m);
   }
   return sum;
@@ -292,7 +291,7 @@ PlanarityTests::SnapChi2 PlanarityTests::snapChi2(const Eigen::Vector3d& n_cam, 
   for (int b : blocks)
   {
     const BlockInfo& info = frame_.blocks[b];
-    const double weight = 1.0 / (info.centroid_variance + kCentroidFloor);
+    const double weight = centroidWeight(b);
     const double offset = n_cam.dot(info.centroid);
     weight_sum += weight;
     offset_sum += weight * offset;

@@ -130,6 +130,8 @@ public:
 private:
   // Moments of the block centroids, each weighted by its inverse centroid variance (count: the weight sum).
   PointMoments noiseWeightedCentroids(const std::vector<int>& blocks) const;
+  // That weight of one block's centroid.
+  double centroidWeight(int block) const { return 1.0 / (frame_.blocks[block].centroid_variance + kCentroidFloor); }
   // The standard error (rad) of a plane's turn that the weighted centroids' spread along
   // `axis` (in the plane) fixes, about their weighted `mean`; the most informative tenth left out.
   double tiltUncertainty(const std::vector<int>& blocks, const Eigen::Vector3d& mean, const Eigen::Vector3d& axis) const;
