@@ -61,7 +61,7 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   const float cap = static_cast<float>(params_.permanence_cap);
   // Thinning first, so a plane seen in this frame ends the frame at least 1 higher.
   thin(cap, frame_planes);
-  dropSuperseded(frame_planes);
+  const std::vector<char> dropped = dropSuperseded(frame_planes);
   // Algorithm 2: every frame plane adds one Gaussian; the peaks are seeded from the cells of
   // this frame's planes and of the map's.
   // A plane this frame measured strongly enough to be reported at first sight (weight 2) is
@@ -70,7 +70,7 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   std::vector<char> full_height;
   for (const FramePlane& plane : frame_planes)
   {
-    const float weight = voteWeight(plane, frame_planes);
+    const float weight = voteWeight(plane, frame_planes, dropped);
     full_height.push_back(weight >= 2.0f);
     addVote(plane.hough, weight, cap);
     seeds.push_back(nearestCell(param_.toCell(plane.hough)));
@@ -363,7 +363,8 @@ void PlaneMap::thin(float cap, const std::vector<FramePlane>& frame_planes)
     global_.thin(static_cast<float>(params_.thinning_rate), cap);
 }
 
-float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes) const
+float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes,
+                           const std::vector<char>& dropped) const
 {
   // A plane not yet in the map adds up to 2 when strongly supported, so that a big plane is
   // reported the first time it is seen, while known planes gain 1 per frame as in the paper
@@ -379,8 +380,9 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
     if (samePlane(known, plane)) return 1.0f;
   if (params_.strong_support <= 0) return 1.0f;
   // A region whose blocks lie off its plane beyond their noise is no measurement of one
-  // surface, however large: it votes 1 as in the paper, and a second frame decides.
-  if (plane.mixes_surfaces) return 1.0f;
+  // surface, however large: it does not vote. A second frame from nearly the same view grows
+  // the same mixture (stair treads with the ramp beside them), so repeating it proves nothing.
+  if (plane.mixes_surfaces) return 0.0f;
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
   // Whether a surface is too small for the curvature tests does not depend on how many regions
   // the frame grew on it (a box top split in two): that test pools the points and support of
@@ -398,9 +400,9 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
   // A region whose blocks pass the noise tests of a plane (FramePlane::fits_its_blocks) is a
   // complete measurement of a new surface whatever its size: one frame reports it, when it is
-  // precise enough that a second measurement would agree with it. Near a known plane it may be
-  // that plane measured badly, and waits for a second frame.
-  if (plane.fits_its_blocks && preciseAtFirstSight(plane) && !nearKnownPlane(plane)) return 2.0f;
+  // precise (preciseAtFirstSight). Near a known plane it may be that plane measured badly, and
+  // waits for a second frame; not near one this frame's measurements just replaced.
+  if (plane.fits_its_blocks && preciseAtFirstSight(plane) && !nearKnownPlane(plane, dropped)) return 2.0f;
   const bool offset_only = plane.parallel && (plane.blocks.empty() || plane.fits_its_blocks);
   const double bar = offset_only ? 0.25 * strong_support : strong_support;
   return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
@@ -408,54 +410,58 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
 
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 {
-  // Two measurements of one surface differ by sqrt(2) sigma; both tolerances hold at 2 sigma
-  // of that difference. The offset is judged where the surface was measured, at its points: a
-  // far face's small tilt error moves its offset at the world origin, not the surface shown.
-  constexpr double kSigmas = 2.0 * M_SQRT2;
+  // The measurement lies within both tolerances of its surface at 2 sigma (95 %); a later,
+  // better measurement that disagrees replaces it (dropSuperseded). The offset is judged where
+  // the surface was measured, at its points: a far face's small tilt error moves its offset at
+  // the world origin, not the surface shown.
+  constexpr double kSigmas = 2.0;
   return kSigmas * measured.normal_sigma <= params_.merge_angle &&
          kSigmas * measured.offset_sigma <= params_.merge_distance;
 }
 
-void PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
+std::vector<char> PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)
 {
   // A young plane (peak at most 2: one first-sight vote or two plain ones) that this frame does
-  // not measure again, while it measures a plane of at least its support within three merge
-  // tolerances of it, was that surface measured badly: the better measurement replaces it
-  // rather than stand beside it. Only its own cells go: a neighbour's peak (a surface beside
-  // it) keeps its votes.
+  // not measure again, while it measures a plane of at least its support near it (nearPlane:
+  // within three merge tolerances at the measurement's points), was that surface measured
+  // badly: the better measurement replaces it rather than stand beside it. Only its own cells
+  // go: a neighbour's peak (a surface beside it) keeps its votes.
+  std::vector<char> dropped(planes_.size(), 0);
   for (size_t p = 0; p < planes_.size(); ++p)
   {
     const DetectedPlane& plane = planes_[p];
     if (plane.strength > 2.0 || remeasured(plane, frame_planes)) continue;
     for (const FramePlane& measured : frame_planes)
     {
-      if (measured.support < plane.support ||
-          !withinMergeTolerances(plane.normal, plane.d, measured.normal, measured.d,
-                                 kNearTolerances * params_.merge_angle, kNearTolerances * params_.merge_distance))
-        continue;
+      if (measured.support < plane.support || !nearPlane(plane, measured)) continue;
       clearOwnPeakCells(p);
+      dropped[p] = 1;
       break;
     }
   }
+  return dropped;
 }
 
-bool PlaneMap::nearKnownPlane(const FramePlane& measured) const
+bool PlaneMap::nearKnownPlane(const FramePlane& measured, const std::vector<char>& dropped) const
+{
+  for (size_t p = 0; p < planes_.size(); ++p)
+    if (!dropped[p] && nearPlane(planes_[p], measured)) return true;
+  return false;
+}
+
+bool PlaneMap::nearPlane(const DetectedPlane& known, const FramePlane& measured) const
 {
   // A tilted fit of a surface turns about its points' centroid, which stays on the surface: a
   // measurement where it was made (offset_sigma > 0) is that plane's only if the plane passes
   // its centroid. Offsets at the world origin would tie a face to any near-parallel one metres
-  // away (a box's back 0.08 rad off another box's side, 8 cm apart at the origin).
+  // away (a box's back 0.08 rad off another box's side, 8 cm apart at the origin), and part a
+  // far face from its own fit tilted by 0.05 rad.
   const double max_angle = kNearTolerances * params_.merge_angle;
   const double max_distance = kNearTolerances * params_.merge_distance;
-  for (const DetectedPlane& known : planes_)
-  {
-    if (measured.offset_sigma > 0.0
-            ? unsignedAngle(known.normal, measured.normal) <= max_angle &&
-                  std::abs(known.normal.dot(measured.centroid) + known.d) <= max_distance
-            : withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, max_angle, max_distance))
-      return true;
-  }
-  return false;
+  return measured.offset_sigma > 0.0
+             ? unsignedAngle(known.normal, measured.normal) <= max_angle &&
+                   std::abs(known.normal.dot(measured.centroid) + known.d) <= max_distance
+             : withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, max_angle, max_distance);
 }
 
 bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured) const

@@ -65,7 +65,7 @@ struct FramePlane
   // snapped plane is judged on the blocks the snap measured it with.
   bool fits_its_blocks = false;
   // Its blocks' centroids lie off it beyond their noise (p = 0.01, noiseBoundOfMeanChi2): it
-  // took blocks of another surface or bends, so one frame does not report it (plane_map.cpp).
+  // took blocks of another surface or bends, so it does not vote (plane_map.cpp).
   bool mixes_surfaces = false;
   std::vector<int> blocks;  // region_growing: the blocks of its region
   // Snapped: the normal the blocks that measured it fit by themselves (world frame, on the side

@@ -92,15 +92,20 @@ private:
   void thinByEvidence(float cap, const std::vector<FramePlane>& frame_planes);
   // True when the frame's plane lies on the map's within the merge tolerances (either side).
   bool samePlane(const DetectedPlane& known, const FramePlane& measured) const;
-  // True when a map plane lies within three merge tolerances of the frame's plane, its offset
+  // True when the map plane lies within three merge tolerances of the frame's plane, its offset
   // judged at the frame plane's centroid when known: more likely a noisy re-measurement of it
-  // than a new surface, so it is not reported at first sight.
-  bool nearKnownPlane(const FramePlane& measured) const;
-  // True when the frame's plane is precise enough that a second measurement of it falls within
-  // the merge tolerances of it: its normal, and its offset at its own points.
+  // than a new surface.
+  bool nearPlane(const DetectedPlane& known, const FramePlane& measured) const;
+  // True when a map plane is near the frame's plane (nearPlane), so it is not reported at first
+  // sight. Map planes flagged in `dropped` (this frame superseded them) do not count: the
+  // measurement is what replaced them.
+  bool nearKnownPlane(const FramePlane& measured, const std::vector<char>& dropped) const;
+  // True when the frame's plane lies within the merge tolerances of its surface at 2 sigma: its
+  // normal, and its offset at its own points.
   bool preciseAtFirstSight(const FramePlane& measured) const;
-  // Clears the cells of one-frame planes this frame measured again elsewhere, nearby.
-  void dropSuperseded(const std::vector<FramePlane>& frame_planes);
+  // Clears the cells of one-frame planes this frame measured again elsewhere, nearby; flags
+  // them, by index of planes_.
+  std::vector<char> dropSuperseded(const std::vector<FramePlane>& frame_planes);
   // Zeroes the cells forPeakCells visits.
   void clearPeakCells(const Eigen::Vector3d& hough);
   // Calls f on every cell of the peak window and blur around `hough` (and its mirrored copy).
@@ -118,8 +123,10 @@ private:
   // True when two planes one frame measured are two surfaces: not similar by eq. 7-8, or their
   // centroids lie farther apart along their normal than their offsets' errors and a face's warp allow.
   bool distinctSurfaces(const FramePlane& a, const FramePlane& b) const;
-  // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map.
-  float voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes) const;
+  // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map
+  // (the planes flagged in `dropped` are no longer in it).
+  float voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes,
+                   const std::vector<char>& dropped) const;
   // The space's peaks as the new plane list, ids carried over from the closest previous plane.
   void matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp);
   // Beliefs follow the ids: new planes start afresh, planes that left the map take theirs along.
