@@ -166,13 +166,15 @@ void print(const SetResult& r, bool causes, bool list)
 int main(int argc, char** argv)
 {
   namespace po = boost::program_options;
-  std::string sets = "tuning,development,development-c1,development-b,table3,other,fig7", osd_dir;
+  std::string sets = "tuning,development,development-c1,development-b,development-b-own,development-c,table3,other,fig7",
+              osd_dir;
   DetectorParams scratch;  // the flags' values are checked here, then applied to every detector
   po::options_description options("options"), detector_options("detector parameters (applied to every run)"), hidden;
   options.add_options()("help,h", "this help")
       ("sets", po::value(&sets)->value_name("LIST"),
        "comma-separated: tuning (seeds 901-908), development (950-965), development-c1 (the same at C = 1), "
-       "development-b (300-339 at C = 1), table3, other, fig7 (default: all)")
+       "development-b (300-339 at C = 1), development-b-own (the same at each room's C), development-c (600-679 at "
+       "each room's C), table3, other, fig7 (default: all)")
       ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
       ("causes", "our misses of each set by what became of their candidate")
       ("noise-correlation", po::value(&noise_correlation_px)->value_name("PX"),
@@ -222,6 +224,10 @@ int main(int argc, char** argv)
       runs.push_back([&] { return runRooms("development seeds, C = 1", kDevelopmentSeeds, params_for, 1.0); });
     else if (set == "development-b")
       runs.push_back([&] { return runRooms("development B seeds, C = 1", kSecondDevelopmentSeeds, params_for, 1.0); });
+    else if (set == "development-b-own")
+      runs.push_back([&] { return runRooms("development B seeds, own C", kSecondDevelopmentSeeds, params_for); });
+    else if (set == "development-c")
+      runs.push_back([&] { return runRooms("development C seeds, own C", kThirdDevelopmentSeeds, params_for); });
     else if (set == "table3")
       runs.push_back([&] { return runTableThree(params_for); });
     else if (set == "other")
@@ -230,7 +236,7 @@ int main(int argc, char** argv)
       runs.push_back([&] { return runFigureSeven(params_for); });
     else
     {
-      std::cerr << "tuning_check: unknown set '" << set << "' (tuning, development, development-c1, development-b, table3, other, fig7)\n";
+      std::cerr << "tuning_check: unknown set '" << set << "' (tuning, development, development-c1, development-b, development-b-own, development-c, table3, other, fig7)\n";
       return 2;
     }
   }

@@ -32,6 +32,7 @@ const std::vector<uint32_t> kTuningSeeds = {901, 902, 903, 904, 905, 906, 907, 9
 const std::vector<uint32_t> kDevelopmentSeeds = {950, 951, 952, 953, 954, 955, 956, 957,
                                                  958, 959, 960, 961, 962, 963, 964, 965};
 const std::vector<uint32_t> kSecondDevelopmentSeeds = seedRange(300, 339);
+const std::vector<uint32_t> kThirdDevelopmentSeeds = seedRange(600, 679);
 
 namespace
 {

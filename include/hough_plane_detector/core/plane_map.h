@@ -100,8 +100,8 @@ private:
   // sight. Map planes flagged in `dropped` (this frame superseded them) do not count: the
   // measurement is what replaced them.
   bool nearKnownPlane(const FramePlane& measured, const std::vector<char>& dropped) const;
-  // True when the frame's plane lies within the merge tolerances of its surface at 2 sigma: its
-  // normal, and its offset at its own points.
+  // True when the frame's plane is precise enough that a second measurement of it falls within
+  // the merge tolerances of it: its normal, and its offset at its own points.
   bool preciseAtFirstSight(const FramePlane& measured) const;
   // Clears the cells of one-frame planes this frame measured again elsewhere, nearby; flags
   // them, by index of planes_.
