@@ -400,8 +400,9 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
   // A region whose blocks pass the noise tests of a plane (FramePlane::fits_its_blocks) is a
   // complete measurement of a new surface whatever its size: one frame reports it, when it is
-  // precise enough that a second measurement would agree with it. Near a known plane it may be that plane measured badly, and
-  // waits for a second frame; not near one this frame's measurements just replaced.
+  // precise enough that a second measurement would agree with it. Near a known plane it may be
+  // that plane measured badly, and waits for a second frame; not near one this frame's
+  // measurements just replaced.
   if (plane.fits_its_blocks && preciseAtFirstSight(plane) && !nearKnownPlane(plane, dropped)) return 2.0f;
   const bool offset_only = plane.parallel && (plane.blocks.empty() || plane.fits_its_blocks);
   const double bar = offset_only ? 0.25 * strong_support : strong_support;
@@ -413,8 +414,6 @@ bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
   // Two measurements of one surface differ by sqrt(2) sigma; both tolerances hold at 2 sigma
   // of that difference. The offset is judged where the surface was measured, at its points: a
   // far face's small tilt error moves its offset at the world origin, not the surface shown.
-  // (At 2 sigma of the measurement alone, development C found 0.6 % more planes and 0.036 more
-  // false ones per frame: duplicates of surfaces measured again beside the first report.)
   constexpr double kSigmas = 2.0 * M_SQRT2;
   return kSigmas * measured.normal_sigma <= params_.merge_angle &&
          kSigmas * measured.offset_sigma <= params_.merge_distance;
