@@ -21,6 +21,40 @@ TEST(PlanarityTests, AWallPassesAndAPillarFails)
   EXPECT_FALSE(f.tests.isPlanarFit(f.tests.weightedMoments(pillar), pillar));
 }
 
+// Along the floor's normal a floor block is as thin as its depth noise makes it; a block
+// across the step's front edge holds points of the front below the top's and is thicker.
+TEST(PlanarityTests, ABlockAcrossAnEdgeIsThickerThanItsNoise)
+{
+  Frame f;
+  const Eigen::Vector3d up = f.frame.normalInCamera(Eigen::Vector3d::UnitZ());
+  const int top = f.truePlane("step_top");
+  ASSERT_GE(top, 0);
+  const int s = blockSize(f.params.normal_window, f.params.normal_stride);
+  int floor_thin = 0, edge_thin = 0, edge = 0;
+  const std::vector<int> floor = f.blocksOn(f.truePlane("floor"));
+  for (int b : floor) floor_thin += f.tests.isThinAlong(b, up);
+  for (size_t b = 0; b < f.frame.blocks.size(); ++b)
+  {
+    if (!f.frame.blocks[b].valid) continue;
+    const int bx = static_cast<int>(b) % f.frame.blocksX(), by = static_cast<int>(b) / f.frame.blocksX();
+    int on_top = 0, on_front = 0;
+    for (int v = by * s; v < (by + 1) * s; ++v)
+      for (int u = bx * s; u < (bx + 1) * s; ++u)
+      {
+        const int plane = f.rendered.pixel_plane[static_cast<size_t>(v) * f.rendered.width + u];
+        on_top += plane == top;
+        on_front += plane >= 0 && plane != top && std::abs(f.renderer.truePlanes()[plane].normal.z()) < 0.1;
+      }
+    if (on_top < s * s / 4 || on_front < s * s / 4) continue;
+    ++edge;
+    edge_thin += f.tests.isThinAlong(static_cast<int>(b), up);
+  }
+  ASSERT_GT(floor.size(), 500u);
+  ASSERT_GE(edge, 5);
+  EXPECT_GE(floor_thin, 0.97 * floor.size());
+  EXPECT_EQ(edge_thin, 0);
+}
+
 TEST(PlanarityTests, AFaceBowedLikeCardboardPassesACanFails)
 {
   // Real box faces bow by about 1/m (osd-learn); a can's side turns 30 times as fast. Both

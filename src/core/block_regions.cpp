@@ -72,6 +72,8 @@ void describeBlockRow(const NormalEstimator& grid, const DetectorParams& params,
     i.tight_residual = noise_aware ? 0.01 + 3.0 * std::sqrt(i.centroid_variance) : params.support_distance;
     i.thickness_limit = noise_aware ? 6.25 * sigma * sigma + 1e-4 : 0.25 * params.support_distance * params.support_distance;
     i.fit_weight = 1.0 / (sigma * sigma + 1e-6);
+    i.random_depth_variance = std::max(0.0, sigma * sigma - step * step / 12.0);
+    i.quantization_step = step;
     i.weighted_centroid = centroidMoments(block);
     i.weighted_centroid.scale(i.fit_weight);
     const double systematic = kSystematicPerSquareMetre * i.centroid.z() * i.centroid.z();

@@ -81,7 +81,9 @@ private:
                                        params_.support_distance ||
           std::abs(n_cam_.dot(info.ray)) < kMinParallelGrazingSine)
         continue;
-      if (n_cam_.dot(info.covariance * n_cam_) > info.thickness_limit) continue;
+      // A block across an edge (a tread's front row holding the riser's top) is no measurement
+      // of one surface: its centroid would pull a cluster off its plane.
+      if (n_cam_.dot(info.covariance * n_cam_) > info.thickness_limit || !tests_.isThinAlong(b, n_cam_)) continue;
       offsets_.emplace_back(-n_cam_.dot(info.centroid) - shift_, b);
     }
     std::sort(offsets_.begin(), offsets_.end());
@@ -189,7 +191,11 @@ private:
           return tests_.centroidChi2(n_cam_, d_cam, patch) <= kMaxMeanCentroidChi2;
         });
     PlaneCandidate candidate{normal_, d, 0.0, moments.count, CandidateVerdict::kAccepted, true};
-    if (moments.count < params_.parallel_support)
+    // Together the patches lie on the plane within their noise (p = 0.01, as a grown region's
+    // FramePlane::mixes_surfaces): a tangent strip's flanks and rows of other surfaces fail.
+    if (!blocks_.empty() && tests_.centroidChi2(n_cam_, d_cam, blocks_) > noiseBoundOfMeanChi2(blocks_.size()))
+      candidate.verdict = CandidateVerdict::kCentroidsOffPlane;
+    else if (moments.count < params_.parallel_support)
       candidate.verdict = CandidateVerdict::kCurvedPatches;
     else if (!tests_.fitIsParallel(n_cam_, blocks_) ||
              !tests_.acceptsKnownNormal(tests_.explainNormal(n_cam_, blocks_, false), normal_))

@@ -322,6 +322,23 @@ bool PlanarityTests::ownNormal(const std::vector<int>& blocks, OwnNormal& own) c
   return true;
 }
 
+bool PlanarityTests::isThinAlong(int block, const Eigen::Vector3d& n_cam) const
+{
+  const BlockInfo& info = frame_.blocks[block];
+  const double points = frame_.points(block);
+  if (!(info.random_depth_variance > 0.0) || points < 2.0) return true;
+  // A depth error moves a point along its ray: by ray / ray.z per metre of depth.
+  const double along_normal = n_cam.dot(info.ray) / info.ray.z();
+  // The random part's sample variance (points - 1 degrees of freedom; the covariance divides
+  // by the count) within its p = 0.01 bound; quantization errors lie within half a step, so
+  // their variance is at most a quarter step squared (points split over two levels).
+  const double random = info.random_depth_variance * noiseBoundOfMeanChi2(static_cast<size_t>(points - 1.0)) *
+                        (points - 1.0) / points;
+  const double bound = (random + 0.25 * info.quantization_step * info.quantization_step) * along_normal * along_normal +
+                       kFaceRoughness * kFaceRoughness;
+  return n_cam.dot(info.covariance * n_cam) <= bound;
+}
+
 double PlanarityTests::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const
 {
   double chi2 = 0.0;

@@ -45,6 +45,8 @@ struct BlockInfo
   double region_residual = 0;    // farthest it may lie from its region's plane: noise and systematic error
   double thickness_limit = 0;    // largest spread along the plane normal
   double fit_weight = 1;         // inverse depth-noise variance
+  double random_depth_variance = 0;  // one point's random depth noise, quantization apart (0: no noise model)
+  double quantization_step = 0;      // the sensor's depth step there (0: none)
   PointMoments weighted_centroid;  // its points moved to their centroid, weighted by fit_weight
 };
 

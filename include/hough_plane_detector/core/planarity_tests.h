@@ -19,6 +19,7 @@ namespace hough_plane_detector
 constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
 constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
 constexpr double kMaxSnapChi2Increase = 9.21;      // a known normal's fit: chi^2 with 2 dof, p = 0.01
+constexpr double kFaceRoughness = 0.001;           // no face is flatter within a block (paint, cardboard), m
 constexpr double kLevelSurfaceCosine = 0.9;        // within 26 deg of level: what one walks or sets things on
 
 // The mean chi^2 per block that n block centroids exceed about their true plane with p = 0.01
@@ -103,6 +104,10 @@ public:
     Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
   };
   bool ownNormal(const std::vector<int>& blocks, OwnNormal& own) const;
+  // The block's points scatter along n_cam no more than their depth noise can (moved along
+  // the rays: the random part within its p = 0.01 bound, quantization within half a step):
+  // a block across an edge or a step is thicker. True without a noise model.
+  bool isThinAlong(int block, const Eigen::Vector3d& n_cam) const;
   // Mean chi^2 of the block centroids about a camera-frame plane.
   double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
   // True when the blocks' own fit is within 2 merge_angle of the camera-frame normal.
