@@ -324,7 +324,7 @@ void FramePlaneFitter::describeMeasurement(FramePlane& plane, const std::vector<
   for (int b : blocks)
   {
     points.add(frame_.moments(b));
-    information += 1.0 / (frame_.blocks[b].centroid_variance + kCentroidFloor);
+    information += tests_.centroidWeight(b);
   }
   if (!(points.count > 0.0)) return;
   plane.centroid = frame_.camera_to_world * points.mean();

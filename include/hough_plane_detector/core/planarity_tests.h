@@ -108,6 +108,8 @@ public:
   // the rays: the random part within its p = 0.01 bound, quantization within half a step):
   // a block across an edge or a step is thicker. True without a noise model.
   bool isThinAlong(int block, const Eigen::Vector3d& n_cam) const;
+  // A block centroid's inverse variance about its true plane (its noise and kCentroidFloor).
+  double centroidWeight(int block) const { return 1.0 / (frame_.blocks[block].centroid_variance + kCentroidFloor); }
   // Mean chi^2 of the block centroids about a camera-frame plane.
   double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
   // True when the blocks' own fit is within 2 merge_angle of the camera-frame normal.
@@ -135,8 +137,6 @@ public:
 private:
   // Moments of the block centroids, each weighted by its inverse centroid variance (count: the weight sum).
   PointMoments noiseWeightedCentroids(const std::vector<int>& blocks) const;
-  // That weight of one block's centroid.
-  double centroidWeight(int block) const { return 1.0 / (frame_.blocks[block].centroid_variance + kCentroidFloor); }
   // The standard error (rad) of a plane's turn that the weighted centroids' spread along
   // `axis` (in the plane) fixes, about their weighted `mean`; the most informative tenth left out.
   double tiltUncertainty(const std::vector<int>& blocks, const Eigen::Vector3d& mean, const Eigen::Vector3d& axis) const;
