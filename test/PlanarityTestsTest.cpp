@@ -22,7 +22,7 @@ TEST(PlanarityTests, AWallPassesAndAPillarFails)
 }
 
 // Along the floor's normal a floor block is as thin as its depth noise makes it; a block
-// across the step's front edge holds points of the front below the top's and is thicker.
+// across the step's top edge holds points of an upright face below the top's and is thicker.
 TEST(PlanarityTests, ABlockAcrossAnEdgeIsThickerThanItsNoise)
 {
   Frame f;
@@ -37,15 +37,15 @@ TEST(PlanarityTests, ABlockAcrossAnEdgeIsThickerThanItsNoise)
   {
     if (!f.frame.blocks[b].valid) continue;
     const int bx = static_cast<int>(b) % f.frame.blocksX(), by = static_cast<int>(b) / f.frame.blocksX();
-    int on_top = 0, on_front = 0;
+    int on_top = 0, on_upright = 0;
     for (int v = by * s; v < (by + 1) * s; ++v)
       for (int u = bx * s; u < (bx + 1) * s; ++u)
       {
         const int plane = f.rendered.pixel_plane[static_cast<size_t>(v) * f.rendered.width + u];
         on_top += plane == top;
-        on_front += plane >= 0 && plane != top && std::abs(f.renderer.truePlanes()[plane].normal.z()) < 0.1;
+        on_upright += plane >= 0 && plane != top && std::abs(f.renderer.truePlanes()[plane].normal.z()) < 0.1;
       }
-    if (on_top < s * s / 4 || on_front < s * s / 4) continue;
+    if (on_top < s * s / 4 || on_upright < s * s / 4) continue;
     ++edge;
     edge_thin += f.tests.isThinAlong(static_cast<int>(b), up);
   }
