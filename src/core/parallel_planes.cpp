@@ -83,7 +83,7 @@ private:
         continue;
       // A block across an edge (a tread's front row holding the riser's top) is no measurement
       // of one surface: its centroid would pull a cluster off its plane.
-      if (n_cam_.dot(info.covariance * n_cam_) > info.thickness_limit || !tests_.isThinAlong(b, n_cam_)) continue;
+      if (!tests_.isThinAlong(b, n_cam_)) continue;
       offsets_.emplace_back(-n_cam_.dot(info.centroid) - shift_, b);
     }
     std::sort(offsets_.begin(), offsets_.end());

@@ -326,7 +326,9 @@ bool PlanarityTests::isThinAlong(int block, const Eigen::Vector3d& n_cam) const
 {
   const BlockInfo& info = frame_.blocks[block];
   const double points = frame_.points(block);
-  if (!(info.random_depth_variance > 0.0) || points < 2.0) return true;
+  const double thickness = n_cam.dot(info.covariance * n_cam);
+  // Without a noise model (or a spread to judge) only the block's fixed thickness_limit applies.
+  if (!(info.random_depth_variance > 0.0) || points < 2.0) return thickness <= info.thickness_limit;
   // A depth error moves a point along its ray: by ray / ray.z per metre of depth.
   const double along_normal = n_cam.dot(info.ray) / info.ray.z();
   // The random part's sample variance (points - 1 degrees of freedom; the covariance divides
@@ -336,7 +338,7 @@ bool PlanarityTests::isThinAlong(int block, const Eigen::Vector3d& n_cam) const
                         (points - 1.0) / points;
   const double bound = (random + 0.25 * info.quantization_step * info.quantization_step) * along_normal * along_normal +
                        kFaceRoughness * kFaceRoughness;
-  return n_cam.dot(info.covariance * n_cam) <= bound;
+  return thickness <= std::min(bound, info.thickness_limit);
 }
 
 double PlanarityTests::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const

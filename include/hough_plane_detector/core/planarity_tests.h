@@ -106,7 +106,8 @@ public:
   bool ownNormal(const std::vector<int>& blocks, OwnNormal& own) const;
   // The block's points scatter along n_cam no more than their depth noise can (moved along
   // the rays: the random part within its p = 0.01 bound, quantization within half a step):
-  // a block across an edge or a step is thicker. True without a noise model.
+  // a block across an edge or a step is thicker. Never beyond the block's thickness_limit;
+  // without a noise model, that limit alone.
   bool isThinAlong(int block, const Eigen::Vector3d& n_cam) const;
   // A block centroid's inverse variance about its true plane (its noise and kCentroidFloor).
   double centroidWeight(int block) const { return 1.0 / (frame_.blocks[block].centroid_variance + kCentroidFloor); }
