@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "hough_plane_detector/core/block_regions.h"
 #include "frame_fixture.h"
@@ -81,18 +82,22 @@ TEST(BlockRegions, ThePillarsCentroidsBendAndTheWallsDoNot)
 
 namespace
 {
-// Blocks of 1 cm on z = depth + curvature x^2 / 2 (camera frame) covering width x height metres,
-// each centroid known to 0.2 mm and each normal to 0.01 rad: the bend is far beyond noise.
-std::vector<BlockInfo> bentPatch(double curvature, double width, double height, double depth)
+// Blocks of `spacing` (1 cm) on z = depth + curvature x^2 / 2 (camera frame) covering width x
+// height metres, each centroid known to model_sigma (0.2 mm) and each normal to 0.01 rad: the
+// bend is far beyond noise. With scatter > 0 the centroids are moved by that much Gaussian noise.
+std::vector<BlockInfo> bentPatch(double curvature, double width, double height, double depth, double spacing = 0.01,
+                                 double model_sigma = 0.0002, double scatter = 0.0)
 {
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 1.0);
   std::vector<BlockInfo> blocks;
-  for (double x = 0.005 - width / 2; x < width / 2; x += 0.01)
-    for (double y = 0.005 - height / 2; y < height / 2; y += 0.01)
+  for (double x = 0.5 * spacing - width / 2; x < width / 2; x += spacing)
+    for (double y = 0.5 * spacing - height / 2; y < height / 2; y += spacing)
     {
       BlockInfo info;
       info.valid = info.planar = true;
-      info.centroid = Eigen::Vector3d(x, y, depth + 0.5 * curvature * x * x);
-      info.centroid_variance = 0.0002 * 0.0002;
+      info.centroid = Eigen::Vector3d(x, y, depth + 0.5 * curvature * x * x + scatter * noise(random));
+      info.centroid_variance = model_sigma * model_sigma;
       info.normal = Eigen::Vector3d(curvature * x, 0.0, -1.0).normalized();
       info.normal_tolerance = 0.01;
       blocks.push_back(info);
@@ -124,6 +129,21 @@ TEST(BlockRegions, ABendThatMovesNoPointAMillimetreIsStillAPlane)
     EXPECT_TRUE(curved(bentPatch(1.0 / 0.033, 0.03, 0.08, 0.7), by_normals)) << by_normals;
     EXPECT_FALSE(curved(bentPatch(0.0, 0.20, 0.05, 0.7), by_normals)) << by_normals;
   }
+}
+
+TEST(BlockRegions, ABendTheNoiseModelHidesShowsInTheRegionsOwnScatter)
+{
+  // A cylinder's tangent strip 2.6 m away (radius 0.35 m, 14 cm wide, 50 cm tall, sag 7 mm) in
+  // blocks of 3.4 cm (8 px there): the noise model gives each centroid 5.4 mm, while they
+  // scatter by 1 mm (rendered quantization averages out over a block). Against the model the bend
+  // is not significant; against the region's own scatter it is.
+  const double depth = 2.6, spacing = 0.034, model_sigma = 0.0054, scatter = 0.001;
+  EXPECT_TRUE(curved(bentPatch(1.0 / 0.35, 0.14, 0.5, depth, spacing, model_sigma, scatter), false));
+  // No bend, or a bow of 3.5 mm (3 /m across 10 cm: within kSurfaceWarp, as cardboard bows), is
+  // a plane however little the blocks scatter (here a 1 m tall face scattering by 0.5 mm, whose
+  // bow the scatter shows clearly).
+  EXPECT_FALSE(curved(bentPatch(0.0, 0.14, 0.5, depth, spacing, model_sigma, scatter), false));
+  EXPECT_FALSE(curved(bentPatch(3.0, 0.10, 1.0, depth, spacing, model_sigma, 0.5 * scatter), false));
 }
 
 TEST(BlockComponents, SplitsASetIntoItsFourConnectedPiecesInTheOrderOfTheirFirstBlock)

@@ -183,9 +183,11 @@ public:
   // True when the rays to most of the blocks graze the plane (under ~6 deg).
   bool seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // True when the block centroids bend away from the plane: a quadric fit explains them
-  // significantly better (chi^2 drop over 3 degrees of freedom, p < 0.001) and its larger
+  // significantly better (p < 0.001: its chi^2 drop over 3 degrees of freedom against the
+  // noise model, or as an F test against their own scatter about the quadric) and its larger
   // principal curvature exceeds what a plane may have (a pillar's, a ball's or a can's side)
-  // with a sag over the region's width beyond kMaxPlaneSag.
+  // with a sag over the region's width beyond kMaxPlaneSag (beyond kSurfaceWarp when only the
+  // F test finds the bend).
   bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
   // True when the blocks' own normals turn across the region, significantly beyond their
   // measured scatter and by more than a plane's curvature and sag may be (a pillar's or can's side).
