@@ -211,7 +211,7 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
   const double chi2_quadric = rr - rhs.dot(quadric);
   // Significant against the sensor's noise model; or against the region's own scatter about
   // the quadric (lack of fit, an F test), which sees a bend the model's conservative variance
-  // hides (a cylinder's tangent strip 2.6 m away: chi^2 drop 9, F 42). That scatter knows
+  // hides (a cylinder's tangent strip 3.5 m away: chi^2 drop 9, F 42). That scatter knows
   // nothing of errors shared along the face, so a bend only it shows must be deeper than a real
   // face warps (kSurfaceWarp: cardboard bowing, a real sensor's low-order depth error).
   const double drop = chi2_plane - chi2_quadric, dof = static_cast<double>(blocks.size()) - 6.0;
