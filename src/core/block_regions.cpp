@@ -23,14 +23,17 @@ constexpr double kMinRaySine = 0.1;  // rays at least ~6 deg to a plane
 // Depth error that does not average out over a block (calibration residue of structured
 // light, surfaces a little off flat), per squared metre of depth: 1.5 mm at 1 m.
 constexpr double kSystematicPerSquareMetre = 0.0015;
+// A quadric's chi^2 drop over a plane's, 3 degrees of freedom, exceeded with p = 0.001.
+constexpr double kChi2DropThreeDof = 16.27;
 
 // The value an F statistic with (3, dof) degrees of freedom exceeds with p = 0.001, as the
 // quadric's chi^2 drop over 3 dof is judged. Tabled once (boost's quantile takes ~14 us); beyond
-// the table it falls as 1/dof toward chi^2(3) / 3 (within 0.02 % of the exact value).
+// the table it falls as 1/dof toward chi^2(3) / 3, the same test with a known variance
+// (within 0.03 % of the exact value).
 double lackOfFitCritical(double dof)
 {
   constexpr int kTabled = 256;
-  constexpr double kLimit = 16.266 / 3.0;
+  constexpr double kLimit = kChi2DropThreeDof / 3.0;
   static const std::vector<double> table = [] {
     std::vector<double> values(kTabled + 1, 0.0);
     for (int n = 1; n <= kTabled; ++n)
@@ -182,7 +185,6 @@ bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::
 
 bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const
 {
-  constexpr double kChi2DropThreeDof = 16.27;  // p = 0.001
   if (blocks.size() < 12) return false;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (int b : blocks) mean += info_[b].centroid;
