@@ -192,8 +192,6 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
   for (const FramePlane& measured : frame_planes)
   {
     if (measured.own_normal.isZero()) continue;
-    // Blocks that do not lie on one plane (a board's top with its edge) measure no plane's normal.
-    if (!measured.fits_its_blocks) continue;
     // The map plane it voted into: the closest within the merge tolerances.
     int match = -1;
     double best_cost = 0.0;
