@@ -335,8 +335,9 @@ RandomSceneExperiment runRandomScenes(bool quick)
   const int frames = result.frames;
   // noise_override > 0: the room's geometry and path at that C instead of its own. defaults_only:
   // no ablations. list_room: the room gets its own row (the held-out seeds at their own C).
+  // rooms: where the defaults' counts in this room go, if anywhere.
   auto runSeed = [&](uint32_t seed, std::vector<MethodStats>& set, bool list_room, double noise_override,
-                     bool defaults_only) {
+                     bool defaults_only, std::vector<RoomCounts>* rooms) {
     RandomScene room = makeRandomScene(seed, frames);
     if (noise_override > 0.0) room.noise = noise_override;
     const size_t used = defaults_only ? 1 : variants.size();
@@ -361,19 +362,22 @@ RandomSceneExperiment runRandomScenes(bool quick)
                                    evaluatedPlanes(detectors[v]->planes())));
     }
     if (list_room) result.rooms.push_back({seed, room.description, stats.front(), stats.back()});
+    if (rooms)
+      rooms->push_back({"seed " + std::to_string(seed), stats.front().detected, stats.front().visible,
+                        stats.front().false_detections, stats.front().frames});
     for (size_t v = 0; v < used; ++v) set[v].merge(stats[v]);
   };
   for (size_t i = 0; i < result.tuning_seeds; ++i)
   {
     std::fprintf(stderr, "  tuning seed %u\n", kTuningSeeds[i]);
-    runSeed(kTuningSeeds[i], result.tuning, false, 0.0, false);
+    runSeed(kTuningSeeds[i], result.tuning, false, 0.0, false, nullptr);
   }
   std::vector<MethodStats> at_c1(1);
   for (size_t i = 0; i < result.held_out_seeds; ++i)
   {
     std::fprintf(stderr, "  held-out seed %u\n", kHeldOutSeeds[i]);
-    runSeed(kHeldOutSeeds[i], result.held_out, true, 0.0, false);
-    runSeed(kHeldOutSeeds[i], at_c1, false, 1.0, true);
+    runSeed(kHeldOutSeeds[i], result.held_out, true, 0.0, false, &result.held_out_rooms);
+    runSeed(kHeldOutSeeds[i], at_c1, false, 1.0, true, &result.held_out_rooms_at_c1);
   }
   result.held_out_at_c1 = at_c1.front();
   // The later lists: the defaults only (variants[0]), pooled with the first in the verdicts.
@@ -383,8 +387,8 @@ RandomSceneExperiment runRandomScenes(bool quick)
     for (size_t i = 0; i < count; ++i)
     {
       std::fprintf(stderr, "  %s held-out seed %u\n", which, seeds[i]);
-      runSeed(seeds[i], at_own, false, 0.0, true);
-      runSeed(seeds[i], at_one, false, 1.0, true);
+      runSeed(seeds[i], at_own, false, 0.0, true, &result.held_out_rooms);
+      runSeed(seeds[i], at_one, false, 1.0, true, &result.held_out_rooms_at_c1);
     }
     own_c = at_own.front();
     c1 = at_one.front();

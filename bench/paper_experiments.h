@@ -16,6 +16,7 @@
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/room_statistics.h"
 #include "pcl_comparators.h"
 
 namespace hough_plane_detector
@@ -154,6 +155,9 @@ struct RandomSceneExperiment
   MethodStats second_held_out, second_held_out_at_c1, third_held_out, third_held_out_at_c1;
   size_t held_out_seeds = 0, second_held_out_seeds = 0, third_held_out_seeds = 0, tuning_seeds = 0;
   std::vector<HeldOutRoom> rooms;              // the held-out seeds one by one
+  // The defaults' counts in each room of all three held-out lists, at its own C and at C = 1:
+  // the verdicts' intervals over rooms.
+  std::vector<RoomCounts> held_out_rooms, held_out_rooms_at_c1;
 };
 RandomSceneExperiment runRandomScenes(bool quick);
 

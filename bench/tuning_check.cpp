@@ -5,9 +5,13 @@
 // same scoring as make evaluate (PCL's methods left out). The held-out seeds are not here on
 // purpose: their figures come from make evaluate only, after a change is decided.
 // With --osd, the annotated real frames of osd-learn too (one frame each, PCL left out).
-// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--list] [--noise-correlation PX] [--PARAM VALUE ...]
+// Each set's line is followed by its 95 % interval over its rooms; --per-room FILE keeps each
+// room's counts, and a later run's --against FILE prints each set's effect paired by room.
+// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--list] [--noise-correlation PX]
+//        [--per-room FILE] [--against FILE] [--PARAM VALUE ...]
 // (see --help)
 #include <cstdio>
+#include <fstream>
 #include <functional>
 #include <future>
 #include <iostream>
@@ -19,6 +23,7 @@
 #include "hough_plane_detector/core/plane_detector.h"
 #include "hough_plane_detector/sim/plane_metrics.h"
 #include "hough_plane_detector/sim/random_scene.h"
+#include "hough_plane_detector/sim/room_statistics.h"
 #include "hough_plane_detector/sim/scene_renderer.h"
 #include "hough_plane_detector/tools/cli_options.h"
 #include "osd_learn.h"
@@ -38,6 +43,7 @@ struct SetResult
 {
   std::string name;
   MethodStats stats;
+  std::vector<RoomCounts> rooms;  // one per camera path, for the intervals over rooms
   std::map<std::string, int> causes;  // our misses by cause
   std::vector<std::string> listed;  // one line per false or missed plane of a scored frame
 };
@@ -84,6 +90,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
   KinectNoise kinect;
   kinect.coefficient = noise;
   kinect.correlation_px = noise_correlation_px;
+  const MethodStats before = result.stats;
   for (size_t f = 0; f < poses.size(); ++f)
   {
     const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
@@ -104,13 +111,16 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
                               std::to_string(frame.visible_points[missed]) + " points): " + cause);
     }
   }
+  result.rooms.push_back({where, result.stats.detected - before.detected, result.stats.visible - before.visible,
+                          result.stats.false_detections - before.false_detections,
+                          result.stats.frames - before.frames});
 }
 
 // noise_override > 0: each room at that C instead of its own, as make evaluate's verdict at C = 1.
 SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const ParamsFor& params_for,
                    double noise_override = 0.0)
 {
-  SetResult result{name, {}, {}, {}};
+  SetResult result{name, {}, {}, {}, {}};
   for (uint32_t seed : seeds)
   {
     RandomScene room = makeRandomScene(seed, kRoomFrames);
@@ -124,7 +134,7 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
 
 SetResult runTableThree(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's tours", {}, {}, {}};
+  SetResult result{"Table 3's tours", {}, {}, {}, {}};
   for (const NamedScene& named : tableThreeScenes())
     runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, 3, params_for(1.0), result);
   return result;
@@ -132,7 +142,7 @@ SetResult runTableThree(const ParamsFor& params_for)
 
 SetResult runOtherTours(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's scenes, other tours", {}, {}, {}};
+  SetResult result{"Table 3's scenes, other tours", {}, {}, {}, {}};
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
       runSequence(std::string(named.name) + ", " + tour.name, named.scene,
@@ -143,7 +153,7 @@ SetResult runOtherTours(const ParamsFor& params_for)
 SetResult runFigureSeven(const ParamsFor& params_for)
 {
   // As make evaluate runs Fig. 7: the paper's thinning, the office at C = 4, resolution 1024.
-  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}};
+  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}, {}};
   DetectorParams params = params_for(4.0);
   params.forgetting = kForgetByThinning;
   runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kFigureSevenStride, params,
@@ -151,11 +161,64 @@ SetResult runFigureSeven(const ParamsFor& params_for)
   return result;
 }
 
-void print(const SetResult& r, bool causes, bool list)
+// Rooms of earlier runs (--per-room's file): set name -> its rooms.
+using RoomsBySet = std::map<std::string, std::vector<RoomCounts>>;
+
+bool readRooms(const std::string& path, RoomsBySet& sets, std::string* error)
+{
+  std::ifstream in(path);
+  if (!in)
+  {
+    *error = "cannot read " + path;
+    return false;
+  }
+  int line_number = 0;
+  for (std::string line; std::getline(in, line);)
+  {
+    ++line_number;
+    std::stringstream fields(line);
+    std::string set;
+    RoomCounts room;
+    if (!std::getline(fields, set, '\t') || !std::getline(fields, room.room, '\t') ||
+        !(fields >> room.detected >> room.visible >> room.false_detections >> room.frames))
+    {
+      *error = path + " line " + std::to_string(line_number) + ": not set<TAB>room<TAB>detected visible false frames";
+      return false;
+    }
+    sets[set].push_back(room);
+  }
+  return true;
+}
+
+void writeRooms(std::ostream& out, const SetResult& r)
+{
+  for (const RoomCounts& room : r.rooms)
+    out << r.name << '\t' << room.room << '\t' << room.detected << ' ' << room.visible << ' ' << room.false_detections
+        << ' ' << room.frames << '\n';
+}
+
+void print(const SetResult& r, bool causes, bool list, const RoomsBySet& earlier)
 {
   std::printf("%-32s %5.1f %% (%d/%d)  false/frame %.3f  E_angle %.4f  E_d %.4f  frames %d\n", r.name.c_str(),
               r.stats.detectionPercent(), r.stats.detected, r.stats.visible, r.stats.falsePerFrame(), mean(r.stats.angle),
               mean(r.stats.d), r.stats.frames);
+  if (r.rooms.size() > 1)
+  {
+    const RoomFigures spread = roomFigures(r.rooms);
+    std::printf("    95 %% over its %zu rooms: found %.1f-%.1f %%, false/frame %.3f-%.3f\n", r.rooms.size(),
+                spread.found_percent.low, spread.found_percent.high, spread.false_per_frame.low,
+                spread.false_per_frame.high);
+  }
+  const auto then = earlier.find(r.name);
+  if (then != earlier.end())
+  {
+    const RoomEffect effect = pairedRoomEffect(then->second, r.rooms);
+    std::printf("    against --against's run, %d of %d rooms changed: found %+.2f %% (95 %% %+.2f..%+.2f), false/frame "
+                "%+.4f (95 %% %+.4f..%+.4f)\n",
+                effect.rooms_changed, effect.rooms, effect.found_percent.value, effect.found_percent.low,
+                effect.found_percent.high, effect.false_per_frame.value, effect.false_per_frame.low,
+                effect.false_per_frame.high);
+  }
   if (list)
     for (const std::string& line : r.listed) std::printf("    %s\n", line.c_str());
   if (!causes) return;
@@ -167,7 +230,7 @@ int main(int argc, char** argv)
 {
   namespace po = boost::program_options;
   std::string sets = "tuning,development,development-c1,development-b,development-b-own,development-c,table3,other,fig7",
-              osd_dir;
+              osd_dir, per_room_path, against_path;
   DetectorParams scratch;  // the flags' values are checked here, then applied to every detector
   po::options_description options("options"), detector_options("detector parameters (applied to every run)"), hidden;
   options.add_options()("help,h", "this help")
@@ -181,7 +244,12 @@ int main(int argc, char** argv)
       ("noise-correlation", po::value(&noise_correlation_px)->value_name("PX"),
        "render spatially correlated noise, a field smoothed over PX pixels (real frames' structure; default 0: "
        "independent per pixel, as make evaluate renders)")
-      ("list", "every false plane of a scored frame (with the true plane nearest it) and every missed one (with its cause)");
+      ("list", "every false plane of a scored frame (with the true plane nearest it) and every missed one (with its cause)")
+      ("per-room", po::value(&per_room_path)->value_name("FILE"),
+       "write each room's (camera path's) counts to FILE, for a later run's --against")
+      ("against", po::value(&against_path)->value_name("FILE"),
+       "a --per-room file of an earlier run (the detector before a change): each set's effect, paired by room, with "
+       "its 95 % interval over rooms and how many rooms changed");
   addDetectorParamOptions(scratch, detector_options, hidden);
   po::options_description all;
   all.add(options).add(detector_options).add(hidden);
@@ -213,6 +281,22 @@ int main(int argc, char** argv)
     }
     return params;
   };
+  RoomsBySet earlier;
+  if (!against_path.empty() && !readRooms(against_path, earlier, &error))
+  {
+    std::cerr << "tuning_check: --against: " << error << "\n";
+    return 2;
+  }
+  std::ofstream per_room;
+  if (!per_room_path.empty())
+  {
+    per_room.open(per_room_path);
+    if (!per_room)
+    {
+      std::cerr << "tuning_check: --per-room: cannot write " << per_room_path << "\n";
+      return 2;
+    }
+  }
   std::vector<std::function<SetResult()>> runs;
   std::stringstream list(sets);
   for (std::string set; std::getline(list, set, ',');)
@@ -248,7 +332,12 @@ int main(int argc, char** argv)
   for (const auto& run : runs) results.push_back(std::async(std::launch::async, run));
   const bool causes = values.count("causes") > 0;
   const bool list_planes = values.count("list") > 0;
-  for (auto& result : results) print(result.get(), causes, list_planes);
+  for (auto& future : results)
+  {
+    const SetResult result = future.get();
+    print(result, causes, list_planes, earlier);
+    if (per_room.is_open()) writeRooms(per_room, result);
+  }
   if (osd_dir.empty()) return 0;
   OsdResults osd;
   DetectorParams osd_params = params_for(0.0);
