@@ -362,9 +362,7 @@ RandomSceneExperiment runRandomScenes(bool quick)
                                    evaluatedPlanes(detectors[v]->planes())));
     }
     if (list_room) result.rooms.push_back({seed, room.description, stats.front(), stats.back()});
-    if (rooms)
-      rooms->push_back({"seed " + std::to_string(seed), stats.front().detected, stats.front().visible,
-                        stats.front().false_detections, stats.front().frames});
+    if (rooms) rooms->push_back(stats.front().roomCounts("seed " + std::to_string(seed)));
     for (size_t v = 0; v < used; ++v) set[v].merge(stats[v]);
   };
   for (size_t i = 0; i < result.tuning_seeds; ++i)

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -12,6 +13,7 @@
 
 #include "hough_plane_detector/core/cloud_view.h"
 #include "hough_plane_detector/sim/plane_metrics.h"
+#include "hough_plane_detector/sim/room_statistics.h"
 
 namespace hough_plane_detector
 {
@@ -44,6 +46,8 @@ struct MethodStats
   double detectionPercent() const { return visible ? 100.0 * detected / visible : 0.0; }
   double falsePerFrame() const { return frames ? static_cast<double>(false_detections) / frames : 0.0; }
   void merge(const MethodStats& other);
+  // Its counts as one room's, for the intervals over rooms.
+  RoomCounts roomCounts(const std::string& room) const { return {room, detected, visible, false_detections, frames}; }
 };
 
 // Both PCL methods on one rendered frame (planes of min_inliers points), timed and scored

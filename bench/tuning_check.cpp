@@ -90,7 +90,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
   KinectNoise kinect;
   kinect.coefficient = noise;
   kinect.correlation_px = noise_correlation_px;
-  const MethodStats before = result.stats;
+  MethodStats room;  // this path's, merged into the set's at its end
   for (size_t f = 0; f < poses.size(); ++f)
   {
     const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
@@ -98,7 +98,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
     if (static_cast<int>(f) < kWarmupFrames || (static_cast<int>(f) - kWarmupFrames) % stride != 0) continue;
     const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
                                                evaluatedPlanes(detector.planes()));
-    result.stats.add(metrics);
+    room.add(metrics);
     for (int k : metrics.false_indices)
       result.listed.push_back("false: " +
           describeFalsePlane(where, static_cast<int>(f), detector, detector.planes()[k], renderer.truePlanes()));
@@ -111,9 +111,8 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
                               std::to_string(frame.visible_points[missed]) + " points): " + cause);
     }
   }
-  result.rooms.push_back({where, result.stats.detected - before.detected, result.stats.visible - before.visible,
-                          result.stats.false_detections - before.false_detections,
-                          result.stats.frames - before.frames});
+  result.stats.merge(room);
+  result.rooms.push_back(room.roomCounts(where));
 }
 
 // noise_override > 0: each room at that C instead of its own, as make evaluate's verdict at C = 1.
