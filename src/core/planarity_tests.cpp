@@ -239,7 +239,9 @@ PlanarityTests::NormalExplanation PlanarityTests::explainNormal(const Eigen::Vec
   const bool no_interior = tested.size() < kMinInteriorBlocks;
   // No interior to tell from the rim: all blocks are tested, once for both verdicts.
   if (no_interior) tested = blocks;
-  const SnapChi2 chi2 = snapChi2(n_cam, tested);
+  SnapSums sums;
+  addToSnapSums(n_cam, tested, 0, sums);
+  const SnapChi2 chi2 = snapChi2Of(sums);
   verdict.interior = chi2.fixed - chi2.free <= kMaxSnapChi2Increase;
   const double free_dof = static_cast<double>(tested.size()) - 3.0;  // a plane's three parameters
   // Without an interior the scatter includes the rim's lean that a snap exists to undo; an
@@ -254,55 +256,72 @@ PlanarityTests::NormalExplanation PlanarityTests::explainNormal(const Eigen::Vec
     return verdict;
   }
   if (!with_rim || !verdict.interior) return verdict;
-  std::vector<int> interior = tested;
-  std::sort(interior.begin(), interior.end());
+  std::vector<char> interior(frame_.blocks.size(), 0);
+  for (int b : tested) interior[b] = 1;
+  const size_t interior_count = tested.size();
   for (int b : blocks)
   {
     const BlockInfo& info = frame_.blocks[b];
-    if (info.normal_tolerance < M_PI / 2 && std::abs(info.normal.dot(n_cam)) >= info.normal_tolerance_cosine &&
-        !std::binary_search(interior.begin(), interior.end(), b))
+    if (!interior[b] && info.normal_tolerance < M_PI / 2 &&
+        std::abs(info.normal.dot(n_cam)) >= info.normal_tolerance_cosine)
       tested.push_back(b);
   }
-  verdict.with_oriented_rim = snapChi2Increase(n_cam, tested) <= kMaxSnapChi2Increase;
+  // The interior's sums go on with the rim (a region of a whole floor has thousands of blocks).
+  addToSnapSums(n_cam, tested, interior_count, sums);
+  const SnapChi2 with_rim_chi2 = snapChi2Of(sums);
+  verdict.with_oriented_rim = with_rim_chi2.fixed - with_rim_chi2.free <= kMaxSnapChi2Increase;
   return verdict;
 }
 
 PointMoments PlanarityTests::noiseWeightedCentroids(const std::vector<int>& blocks) const
 {
-  const int bx_count = frame_.normals.blocksX();
   PointMoments sum;
-  for (int b : blocks)
-  {
-    PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
-    if (m.count <= 0.0) continue;  // an empty block has no centroid
-    m.scale(centroidWeight(b) / m.count);
-    sum.add(m);
-  }
+  for (int b : blocks) addNoiseWeightedCentroid(b, centroidWeight(b), sum);
   return sum;
+}
+
+void PlanarityTests::addNoiseWeightedCentroid(int b, double weight, PointMoments& sum) const
+{
+  const int bx_count = frame_.normals.blocksX();
+  PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
+  if (m.count <= 0.0) return;  // an empty block has no centroid
+  m.scale(weight / m.count);
+  sum.add(m);
 }
 
 PlanarityTests::SnapChi2 PlanarityTests::snapChi2(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks) const
 {
+  SnapSums sums;
+  addToSnapSums(n_cam, blocks, 0, sums);
+  return snapChi2Of(sums);
+}
+
+void PlanarityTests::addToSnapSums(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks, size_t first,
+                                   SnapSums& sums) const
+{
+  for (size_t k = first; k < blocks.size(); ++k)
+  {
+    const int b = blocks[k];
+    const double weight = centroidWeight(b);
+    addNoiseWeightedCentroid(b, weight, sums.centroids);
+    const double offset = n_cam.dot(frame_.blocks[b].centroid);
+    sums.weight += weight;
+    sums.offset += weight * offset;
+    sums.offset_squares += weight * offset * offset;
+  }
+}
+
+PlanarityTests::SnapChi2 PlanarityTests::snapChi2Of(const SnapSums& sums)
+{
   // Centroids weighted by their inverse variance: the smallest eigenvalue of their scatter
   // times the total weight is the chi^2 of the best free plane; the fixed normal's best plane
   // has the weighted variance of the offsets along it.
-  const PointMoments sum = noiseWeightedCentroids(blocks);
-  double weight_sum = 0.0, offset_sum = 0.0, offset_squares = 0.0;
-  for (int b : blocks)
-  {
-    const BlockInfo& info = frame_.blocks[b];
-    const double weight = centroidWeight(b);
-    const double offset = n_cam.dot(info.centroid);
-    weight_sum += weight;
-    offset_sum += weight * offset;
-    offset_squares += weight * offset * offset;
-  }
   SnapChi2 chi2;
-  if (weight_sum <= 0.0) return chi2;
-  chi2.fixed = offset_squares - offset_sum * offset_sum / weight_sum;
+  if (sums.weight <= 0.0) return chi2;
+  chi2.fixed = sums.offset_squares - sums.offset * sums.offset / sums.weight;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(sum.covariance());
-  chi2.free = std::max(0.0, solver.eigenvalues()(0)) * sum.count;
+  solver.computeDirect(sums.centroids.covariance());
+  chi2.free = std::max(0.0, solver.eigenvalues()(0)) * sums.centroids.count;
   return chi2;
 }
 

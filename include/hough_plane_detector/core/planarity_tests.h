@@ -138,6 +138,16 @@ public:
 private:
   // Moments of the block centroids, each weighted by its inverse centroid variance (count: the weight sum).
   PointMoments noiseWeightedCentroids(const std::vector<int>& blocks) const;
+  void addNoiseWeightedCentroid(int block, double weight, PointMoments& sum) const;
+  // snapChi2's running sums, so that a test of more blocks goes on from a test of fewer.
+  struct SnapSums
+  {
+    PointMoments centroids;  // noiseWeightedCentroids
+    double weight = 0.0, offset = 0.0, offset_squares = 0.0;
+  };
+  // Adds blocks[first..] to `sums`, in order (the same sums as over the whole list at once).
+  void addToSnapSums(const Eigen::Vector3d& n_cam, const std::vector<int>& blocks, size_t first, SnapSums& sums) const;
+  static SnapChi2 snapChi2Of(const SnapSums& sums);
   // The standard error (rad) of a plane's turn that the weighted centroids' spread along
   // `axis` (in the plane) fixes, about their weighted `mean`; the most informative tenth left out.
   double tiltUncertainty(const std::vector<int>& blocks, const Eigen::Vector3d& mean, const Eigen::Vector3d& axis) const;
