@@ -352,7 +352,6 @@ std::vector<std::vector<int>> BlockRegionGrower::seedComponents(const Eigen::Vec
 PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::Vector3d& normal, double d,
                                     const std::vector<char>& taken)
 {
-  const int bx_count = grid_.blocksX();
   PlaneRegion region;
   region.normal = normal;
   region.d = d;
@@ -382,7 +381,7 @@ PlaneRegion BlockRegionGrower::grow(const std::vector<int>& seed, const Eigen::V
     region.blocks.swap(inliers);
     region.trimmed.insert(region.trimmed.end(), outliers.begin(), outliers.end());
   }
-  for (int b : region.blocks) region.points += grid_.block(b % bx_count, b / bx_count).count;
+  for (int b : region.blocks) region.points += grid_.block(b).count;
   return region;
 }
 

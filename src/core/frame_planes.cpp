@@ -256,9 +256,8 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
   std::vector<int> order;
   for (size_t b = 0; b < frame_.blocks.size(); ++b)
     if (frame_.blocks[b].planar && !frame_.block_claim[b] && !tried[b]) order.push_back(static_cast<int>(b));
-  const int bx_count = frame_.normals.blocksX();
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    return frame_.normals.block(a % bx_count, a / bx_count).count > frame_.normals.block(b % bx_count, b / bx_count).count;
+    return frame_.normals.block(a).count > frame_.normals.block(b).count;
   });
   for (int b : order)
   {
@@ -575,8 +574,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   const Eigen::Vector3d n_cam = frame_.normalInCamera(known);
   // The offset most points agree on (a median: the leaning blocks are outliers), then the
   // blocks within three of their sigmas of it.
-  const int bx_count = frame_.normals.blocksX();
-  auto points = [&](int b) { return frame_.normals.block(b % bx_count, b / bx_count).count; };
+  auto points = [&](int b) { return frame_.normals.block(b).count; };
   std::vector<std::pair<double, double>> offsets;  // camera-frame d of each block, its points
   double total = 0.0;
   for (int b : blocks)

@@ -22,12 +22,11 @@ bool PlanarityTests::isPlanarFit(const PointMoments& moments, const std::vector<
   solver.computeDirect(moments.covariance());
   const Eigen::Vector3d normal = solver.eigenvectors().col(0);
   const Eigen::Vector3d mean = moments.mean();
-  const int bx_count = frame_.normals.blocksX();
   double chi2 = 0.0;
   for (int b : blocks)
   {
     const BlockInfo& info = frame_.blocks[b];
-    const double count = frame_.normals.block(b % bx_count, b / bx_count).count;
+    const double count = frame_.normals.block(b).count;
     // The block's own scatter along the plane normal: noise if it lies on the plane.
     const double own_variance = std::max(0.0, normal.dot(info.covariance * normal));
     const double step = frame_.noise.quantizationStep(info.centroid.z());
@@ -211,7 +210,7 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
   });
   blocks.swap(kept);
   PointMoments moments;
-  for (int b : blocks) moments.add(frame_.normals.block(b % bx_count, b / bx_count));
+  for (int b : blocks) moments.add(frame_.normals.block(b));
   return moments;
 }
 
@@ -282,8 +281,7 @@ PointMoments PlanarityTests::noiseWeightedCentroids(const std::vector<int>& bloc
 
 void PlanarityTests::addNoiseWeightedCentroid(int b, double weight, PointMoments& sum) const
 {
-  const int bx_count = frame_.normals.blocksX();
-  PointMoments m = centroidMoments(frame_.normals.block(b % bx_count, b / bx_count));
+  PointMoments m = centroidMoments(frame_.normals.block(b));
   if (m.count <= 0.0) return;  // an empty block has no centroid
   m.scale(weight / m.count);
   sum.add(m);

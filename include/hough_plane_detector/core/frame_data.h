@@ -43,7 +43,7 @@ struct FrameData
 
   int blocksX() const { return normals.blocksX(); }
   int blocksY() const { return normals.blocksY(); }
-  const PointMoments& moments(int block) const { return normals.block(block % blocksX(), block / blocksX()); }
+  const PointMoments& moments(int block) const { return normals.block(block); }
   double points(int block) const { return moments(block).count; }
   // A world plane (normal, d) in the camera frame, where the blocks are.
   Eigen::Vector3d normalInCamera(const Eigen::Vector3d& normal) const { return camera_to_world.linear().transpose() * normal; }

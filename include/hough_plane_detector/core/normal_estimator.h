@@ -89,6 +89,8 @@ public:
   int blocksX() const { return blocks_x_; }
   int blocksY() const { return blocks_y_; }
   const PointMoments& block(int bx, int by) const { return blocks_[static_cast<size_t>(by) * blocks_x_ + bx]; }
+  // The same by its row-major index by * blocksX() + bx, as regions list their blocks.
+  const PointMoments& block(int index) const { return blocks_[static_cast<size_t>(index)]; }
   // Number of windows with enough valid points in the last cloud.
   int validWindows() const { return valid_windows_; }
 
