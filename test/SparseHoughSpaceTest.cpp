@@ -108,3 +108,24 @@ TEST(SparseHoughSpace, EvictingKeepsTheStrongestChunks)
   EXPECT_FLOAT_EQ(space.value(20, 1, 1), 3.0f);
   EXPECT_FLOAT_EQ(space.value(1, 20, 1), 9.0f);
 }
+
+TEST(SparseHoughSpace, FreedChunksArePooledUpToTheSpacesLimit)
+{
+  // Three chunks written and cleared: a pool of two keeps two for reuse, the third goes back.
+  SparseHoughSpace space(64, 64, 64, 2);
+  for (int z : {0, 16, 32}) space.add(0, 0, z, 1.0f);
+  ASSERT_EQ(space.chunkCount(), 3u);
+  space.clear();
+  EXPECT_EQ(space.chunkCount(), 0u);
+  EXPECT_EQ(space.bytesPooled(), 2u * sizeof(float) * SparseHoughSpace::kChunkCells);
+  // A reused chunk starts at zero.
+  space.add(0, 0, 48, 2.0f);
+  EXPECT_EQ(space.bytesPooled(), 1u * sizeof(float) * SparseHoughSpace::kChunkCells);
+  EXPECT_EQ(space.value(0, 0, 48), 2.0f);
+  EXPECT_EQ(space.value(0, 0, 49), 0.0f);
+  EXPECT_EQ(space.value(0, 0, 0), 0.0f);
+  SparseHoughSpace default_pool(64, 64, 64);
+  for (int z : {0, 16, 32}) default_pool.add(0, 0, z, 1.0f);
+  default_pool.clear();
+  EXPECT_EQ(default_pool.bytesPooled(), 3u * sizeof(float) * SparseHoughSpace::kChunkCells);
+}

@@ -6,8 +6,8 @@
 namespace hough_plane_detector
 {
 
-SparseHoughSpace::SparseHoughSpace(int size_x, int size_y, int size_z)
-  : size_x_(size_x), size_y_(size_y), size_z_(size_z)
+SparseHoughSpace::SparseHoughSpace(int size_x, int size_y, int size_z, size_t max_pooled_chunks)
+  : size_x_(size_x), size_y_(size_y), size_z_(size_z), max_pooled_chunks_(max_pooled_chunks)
 {
   chunks_x_ = (size_x + kChunkEdge - 1) / kChunkEdge;
   chunks_y_ = (size_y + kChunkEdge - 1) / kChunkEdge;
@@ -141,8 +141,8 @@ void SparseHoughSpace::clear()
 
 void SparseHoughSpace::release(int chunk_index)
 {
-  // A small pool spares the per-frame space a malloc per chunk; beyond it memory goes back.
-  if (pool_.size() < kMaxPooledChunks)
+  // The pool spares a malloc and fresh pages per chunk; beyond it memory goes back.
+  if (pool_.size() < max_pooled_chunks_)
     pool_.push_back(std::move(slot(chunk_index)));
   else
     slot(chunk_index).reset();

@@ -390,6 +390,7 @@ void PlaneDetectorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("Hough space MB", memory.global_bytes / 1e6);
   status.add("Hough space % of dense", 100.0 * memory.global_bytes / std::max<size_t>(1, memory.dense_bytes));
   status.add("Hough chunks", memory.global_chunks);
+  status.add("per-frame Hough space MB (with its reuse pool)", (memory.local_bytes + memory.local_pooled_bytes) / 1e6);
   status.add("Hough chunks freed by max_chunks", memory.chunks_evicted_total);
   status.add("votes beyond max_distance (last frame)", detector_->lastStats().votes_out_of_range);
   const HoughParameterization& grid = detector_->parameterization();

@@ -57,6 +57,7 @@ struct MemoryReport
   size_t global_bytes = 0;      // top grid + allocated chunks of the persistent space
   size_t global_chunks = 0;
   size_t local_bytes = 0;       // per-frame space, as allocated in the last frame
+  size_t local_pooled_bytes = 0;  // its freed chunks kept for the next frame's (16 MB at most)
   size_t dense_bytes = 0;       // a dense float array of the same grid
   size_t top_level_cells = 0;
   size_t chunks_evicted_total = 0;  // freed by the max_chunks cap since the map began

@@ -20,7 +20,10 @@ public:
   static constexpr int kChunkEdge = 1 << kChunkBits;
   static constexpr int kChunkCells = kChunkEdge * kChunkEdge * kChunkEdge;
 
-  SparseHoughSpace(int size_x, int size_y, int size_z);
+  // Freed chunks up to max_pooled_chunks are kept for reuse: memory handed back to the system
+  // and asked for again costs a page fault per 4 KB, on every frame for a per-frame space.
+  static constexpr size_t kDefaultPooledChunks = 256;
+  SparseHoughSpace(int size_x, int size_y, int size_z, size_t max_pooled_chunks = kDefaultPooledChunks);
 
   int sizeX() const { return size_x_; }
   int sizeY() const { return size_y_; }
@@ -93,7 +96,6 @@ public:
 private:
   // One chunk layer in d: a pointer per (x, y) chunk column.
   using Slab = std::unique_ptr<std::unique_ptr<float[]>[]>;
-  static constexpr size_t kMaxPooledChunks = 256;
   void release(int chunk_index);
   std::unique_ptr<float[]>& slot(int chunk_index);
   int column(int x, int y) const { return (x >> kChunkBits) * chunks_y_ + (y >> kChunkBits); }
@@ -108,6 +110,7 @@ private:
   int chunks_x_, chunks_y_, chunks_z_;
   std::vector<Slab> slabs_;  // chunks_z_ of them, allocated on first write
   size_t slab_count_ = 0;
+  size_t max_pooled_chunks_;
   std::vector<int> allocated_;
   std::vector<std::unique_ptr<float[]>> pool_;
 };
