@@ -40,17 +40,32 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
 {
   const MatchTolerance tolerance;
   const PlaneCandidate* best = nullptr;
-  double best_cost = 0.0;
+  const PlaneCandidate* nearest = nullptr;  // of the candidates beyond the tolerance
+  double best_cost = 0.0, nearest_cost = 0.0;
   for (const PlaneCandidate& c : detector.lastCandidates())
   {
     const double ea = angleError(c.normal, truth.normal), ed = distanceError(c.normal, c.d, truth.normal, truth.d);
     const double cost = ea / tolerance.angle + ed / tolerance.distance;
-    if (ea <= tolerance.angle && ed <= tolerance.distance && (!best || cost < best_cost))
+    const bool within = ea <= tolerance.angle && ed <= tolerance.distance;
+    if (within && (!best || cost < best_cost))
     {
       best = &c;
       best_cost = cost;
     }
+    else if (!within && (!nearest || cost < nearest_cost))
+    {
+      nearest = &c;
+      nearest_cost = cost;
+    }
   }
+  // A candidate a little beyond the tolerance is mostly a fit of this surface and one beside it
+  // (a stacked box's face grown with the face below it, a stair's front with its tread).
+  constexpr double kNearCandidateCost = 3.0;  // in units of the tolerances, summed
+  if (!best && nearest && nearest_cost <= kNearCandidateCost)
+    return nearest->verdict == CandidateVerdict::kAccepted
+               ? "no candidate within the tolerance; the nearest (1-3 tolerances off) was accepted"
+               : std::string("no candidate within the tolerance; the nearest (1-3 tolerances off): ") +
+                     toString(nearest->verdict);
   if (!best) return "no Hough peak";
   if (best->verdict == CandidateVerdict::kAccepted)
   {

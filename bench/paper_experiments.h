@@ -34,7 +34,8 @@ constexpr uint32_t kNoiseTourSeed = 7000;  // noise seed of Fig. 6-7's office to
 DetectorParams paramsFor(double noise, int resolution);
 
 // Why our detector missed a visible true plane in its last frame: the fate of the local peak
-// that matches it, or no peak at all, or a per-frame plane the map has not reported yet.
+// that matches it, or of the nearest candidate within three tolerances when none matches, or
+// no peak at all, or a per-frame plane the map has not reported yet.
 std::string missCause(const PlaneDetector& detector, const TruePlane& truth);
 
 // Table 3's three scenes, and the other camera paths they are also toured along.
