@@ -408,7 +408,7 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
   // degrees apart) lies off its plane beyond its blocks' noise. Two planes fitted by
   // alternating assignment (each block to the plane nearer it), started from the region's
   // halves along each of its two in-plane axes, explain it when each part, connected, lies on
-  // its own plane within that noise. The parts are returned without their stray blocks.
+  // its own plane within that noise. The parts are returned without the blocks on neither.
   const std::vector<int>& blocks = region.blocks;
   if (blocks.size() < 2 * kMinInteriorBlocks) return false;
   if (tests_.centroidChi2(region.normal, region.d, blocks) <= noiseBoundOfMeanChi2(blocks.size())) return false;
@@ -443,17 +443,65 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
       b.swap(next_b);
     }
     if (!grower.fit(a, n_a, d_a) || !grower.fit(b, n_b, d_b)) return -1.0;
-    const double chi2_a = tests_.centroidChi2(n_a, d_a, a), chi2_b = tests_.centroidChi2(n_b, d_b, b);
-    if (chi2_a > noiseBoundOfMeanChi2(a.size()) || chi2_b > noiseBoundOfMeanChi2(b.size())) return -1.0;
-    // Each part must be one piece of surface, give or take the tenth of its blocks near the
-    // planes' crossing, which lie on both within their noise.
-    constexpr double kMinConnectedShare = 0.9;
-    std::vector<int> main_a = largestComponent(a), main_b = largestComponent(b);
-    if (main_a.size() < kMinConnectedShare * a.size() || main_b.size() < kMinConnectedShare * b.size()) return -1.0;
-    const double total_chi2 = chi2_a * a.size() + chi2_b * b.size();  // of the whole region, as split
-    a.swap(main_a);
-    b.swap(main_b);
-    return total_chi2;
+    // Blocks near the line where the two planes cross lie on both within their noise, and the
+    // assignment by distance scatters them across it. Each part is its largest connected piece
+    // grown over the blocks that touch it and lie on its plane within three sigmas; it must be
+    // one piece give or take a tenth of its blocks, which then lie on neither piece and are left out.
+    const int bx_count = frame_.blocksX(), by_count = frame_.blocksY();
+    std::vector<signed char> owner(frame_.blocks.size(), -1);
+    for (int block : largestComponent(a)) owner[block] = 0;
+    for (int block : largestComponent(b)) owner[block] = 1;
+    const Eigen::Vector3d normals[2] = {n_a, n_b};
+    const double offsets[2] = {d_a, d_b};
+    auto distance = [&](int block, int part) {
+      return normals[part].dot(frame_.blocks[block].centroid) + offsets[part];
+    };
+    auto variance = [&](int block) { return frame_.blocks[block].centroid_variance + kCentroidFloor; };
+    auto touches = [&](int block, int part) {
+      const int x = block % bx_count, y = block / bx_count;
+      return (x > 0 && owner[block - 1] == part) || (x + 1 < bx_count && owner[block + 1] == part) ||
+             (y > 0 && owner[block - bx_count] == part) || (y + 1 < by_count && owner[block + bx_count] == part);
+    };
+    for (bool grew = true; grew;)
+    {
+      grew = false;
+      for (int block : blocks)
+      {
+        if (owner[block] >= 0) continue;
+        const int nearer = std::abs(distance(block, 0)) <= std::abs(distance(block, 1)) ? 0 : 1;
+        for (int part : {nearer, 1 - nearer})
+          if (touches(block, part) && std::pow(distance(block, part), 2) <= 9.0 * variance(block))
+          {
+            owner[block] = static_cast<signed char>(part);
+            grew = true;
+            break;
+          }
+      }
+    }
+    constexpr double kMaxLeftOutShare = 0.1;
+    std::vector<int> pieces[2];
+    size_t left_out[2] = {0, 0};  // of each part as assigned
+    double left_out_chi2 = 0.0;
+    std::vector<char> in_a(frame_.blocks.size(), 0);
+    for (int block : a) in_a[block] = 1;
+    for (int block : blocks)
+    {
+      if (owner[block] >= 0)
+      {
+        pieces[owner[block]].push_back(block);
+        continue;
+      }
+      ++left_out[in_a[block] ? 0 : 1];
+      left_out_chi2 += std::min(std::pow(distance(block, 0), 2), std::pow(distance(block, 1), 2)) / variance(block);
+    }
+    if (left_out[0] > kMaxLeftOutShare * a.size() || left_out[1] > kMaxLeftOutShare * b.size()) return -1.0;
+    if (pieces[0].size() < kMinInteriorBlocks || pieces[1].size() < kMinInteriorBlocks) return -1.0;
+    if (!grower.fit(pieces[0], n_a, d_a) || !grower.fit(pieces[1], n_b, d_b)) return -1.0;
+    const double chi2_a = tests_.centroidChi2(n_a, d_a, pieces[0]), chi2_b = tests_.centroidChi2(n_b, d_b, pieces[1]);
+    if (chi2_a > noiseBoundOfMeanChi2(pieces[0].size()) || chi2_b > noiseBoundOfMeanChi2(pieces[1].size())) return -1.0;
+    a.swap(pieces[0]);
+    b.swap(pieces[1]);
+    return chi2_a * a.size() + chi2_b * b.size() + left_out_chi2;  // of the whole region, as split
   };
   PointMoments centroids;
   for (int block : blocks) centroids.add(centroidMoments(frame_.moments(block)));
