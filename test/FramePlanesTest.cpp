@@ -174,18 +174,14 @@ TEST(FramePlaneFitter, ASnappedPlaneIsJudgedOnTheBlocksThatMeasuredIt)
   EXPECT_FALSE(table_top->mixes_surfaces);
 }
 
-TEST(FramePlaneFitter, ARegionOverTwoStackedFacesIsSplitIntoTheirPlanes)
+namespace
 {
-  // Two stacked boxes, the upper turned 0.07 rad about their shared back edge: their backs meet
-  // at the edge and one region grows over both, its plane between them.
-  Scene scene;
-  scene.addRectangle(Eigen::Vector3d(3, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5, 3, "floor");
-  const double yaw = 0.07;
-  const Eigen::Vector3d half(0.3, 0.4, 0.25), edge(2.0, -0.4, 0.0), to_centre(0.3, 0.4, 0.0);
-  scene.addBox(edge + to_centre + Eigen::Vector3d(0, 0, 0.25), half, 0.0, "lower");
-  scene.addBox(edge + Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * to_centre + Eigen::Vector3d(0, 0, 0.75), half,
-               yaw, "upper");
-  Frame f(scene, lookAt(Eigen::Vector3d(0, 0.3, 1.0), Eigen::Vector3d(2.0, 0, 0.5)));
+// The regions grown from the lower box's back include a plane of each box's back (boxes
+// "lower" and "upper"), each within 0.01 rad and 1 cm, of 100+ blocks that fit it, and no region
+// of 100+ blocks that mixes surfaces.
+void expectBothBacksMeasured(const Scene& scene, const Eigen::Isometry3d& camera_to_world)
+{
+  Frame f(scene, camera_to_world);
   FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
   const TruePlane& lower = f.renderer.truePlanes()[f.truePlane("lower_back")];
   const TruePlane& upper = f.renderer.truePlanes()[f.truePlane("upper_back")];
@@ -204,6 +200,21 @@ TEST(FramePlaneFitter, ARegionOverTwoStackedFacesIsSplitIntoTheirPlanes)
   for (const FramePlane& plane : planes)
     EXPECT_FALSE(plane.blocks.size() >= 100 && plane.mixes_surfaces) << "a large region mixes the two backs";
 }
+}  // namespace
+
+TEST(FramePlaneFitter, ARegionOverTwoStackedFacesIsSplitIntoTheirPlanes)
+{
+  // Two stacked boxes, the upper turned 0.07 rad about their shared back edge: their backs meet
+  // at the edge and one region grows over both, its plane between them.
+  Scene scene;
+  scene.addRectangle(Eigen::Vector3d(3, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5, 3, "floor");
+  const double yaw = 0.07;
+  const Eigen::Vector3d half(0.3, 0.4, 0.25), edge(2.0, -0.4, 0.0), to_centre(0.3, 0.4, 0.0);
+  scene.addBox(edge + to_centre + Eigen::Vector3d(0, 0, 0.25), half, 0.0, "lower");
+  scene.addBox(edge + Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * to_centre + Eigen::Vector3d(0, 0, 0.75), half,
+               yaw, "upper");
+  expectBothBacksMeasured(scene, lookAt(Eigen::Vector3d(0, 0.3, 1.0), Eigen::Vector3d(2.0, 0, 0.5)));
+}
 
 TEST(FramePlaneFitter, ARegionOverTwoFacesThatCrossMidwayIsSplitIntoTheirPlanes)
 {
@@ -211,30 +222,13 @@ TEST(FramePlaneFitter, ARegionOverTwoFacesThatCrossMidwayIsSplitIntoTheirPlanes)
   // region, and the blocks on both sides of the crossing lie on either plane within their noise
   // at 2.5 m, so the assignment by distance scatters them across it and neither part is one
   // piece. Grown over the blocks that lie on its plane, each part is one piece again: the region
-  // is split into the two backs (before, it was kept whole and flagged as mixing surfaces).
+  // is split into the two backs.
   Scene scene;
   scene.addRectangle(Eigen::Vector3d(3, 0, 0), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5, 3, "floor");
   const Eigen::Vector3d half(0.3, 0.4, 0.25);
   scene.addBox(Eigen::Vector3d(2.8, 0.0, 0.25), half, 0.0, "lower");
   scene.addBox(Eigen::Vector3d(2.8, 0.0, 0.75), half, 0.07, "upper");
-  Frame f(scene, lookAt(Eigen::Vector3d(0, 0.3, 1.2), Eigen::Vector3d(2.5, 0, 0.5)));
-  FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
-  const TruePlane& lower = f.renderer.truePlanes()[f.truePlane("lower_back")];
-  const TruePlane& upper = f.renderer.truePlanes()[f.truePlane("upper_back")];
-  std::vector<FramePlane> planes;
-  std::vector<PlaneCandidate> candidates;
-  fitter.growRegions({f.peakOf(lower)}, {}, planes, candidates);
-  auto measured = [&](const TruePlane& truth) {
-    for (const FramePlane& plane : planes)
-      if (angleBetween(plane.normal, truth.normal) < 0.01 && std::abs(std::abs(plane.d) - std::abs(truth.d)) < 0.01 &&
-          plane.fits_its_blocks && plane.blocks.size() >= 100)
-        return true;
-    return false;
-  };
-  EXPECT_TRUE(measured(lower)) << "the lower box's back, within 0.01 rad and 1 cm, fitting its blocks";
-  EXPECT_TRUE(measured(upper)) << "the upper box's back, within 0.01 rad and 1 cm, fitting its blocks";
-  for (const FramePlane& plane : planes)
-    EXPECT_FALSE(plane.blocks.size() >= 100 && plane.mixes_surfaces) << "a large region mixes the two backs";
+  expectBothBacksMeasured(scene, lookAt(Eigen::Vector3d(0, 0.3, 1.2), Eigen::Vector3d(2.5, 0, 0.5)));
 }
 
 // A wall of which only two block rows, 16 blocks long, are measured flat (the rest as if
