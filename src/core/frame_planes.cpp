@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "hough_plane_detector/core/block_regions.h"
 #include "hough_plane_detector/core/plane_geometry.h"
 
 namespace hough_plane_detector
@@ -458,9 +459,9 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
     };
     auto variance = [&](int block) { return frame_.blocks[block].centroid_variance + kCentroidFloor; };
     auto touches = [&](int block, int part) {
-      const int x = block % bx_count, y = block / bx_count;
-      return (x > 0 && owner[block - 1] == part) || (x + 1 < bx_count && owner[block + 1] == part) ||
-             (y > 0 && owner[block - bx_count] == part) || (y + 1 < by_count && owner[block + bx_count] == part);
+      bool touching = false;
+      forEachNeighbour(block, bx_count, by_count, [&](int neighbour) { touching |= owner[neighbour] == part; });
+      return touching;
     };
     for (bool grew = true; grew;)
     {
