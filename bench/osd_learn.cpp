@@ -131,9 +131,27 @@ std::string missReason(const PlaneDetector& detector, const Entry& entry)
   if (!nearest || nearest_cost > 4.0) return "no Hough peak near it";
   std::string reason = toString(nearest->verdict);
   if (nearest_cost > 2.0) return "nearest peak far off (" + reason + ")";
-  if (nearest->verdict == CandidateVerdict::kAccepted)
-    return nearest_cost <= 2.0 && nearest_cost > 1.0 ? "accepted, fitted beyond the tolerance" : "accepted, not in the map";
-  return reason;
+  if (nearest->verdict != CandidateVerdict::kAccepted) return reason;
+  if (nearest_cost > 1.0) return "accepted, fitted beyond the tolerance";
+  // A map plane that matches it but counted for an entry it fits better: one plane for both.
+  for (const DetectedPlane& plane : detector.planes())
+    if (matches(plane.normal, plane.d, entry)) return "accepted, one map plane with another entry";
+  // Why the map did not report it at first sight: how the frame's plane on it voted.
+  const std::vector<FramePlane>& measured = detector.lastFramePlanes();
+  const std::vector<FirstSight>& first_sights = detector.map().lastFirstSights();
+  int best = -1;
+  double best_cost = 0.0;
+  for (size_t i = 0; i < measured.size() && i < first_sights.size(); ++i)
+  {
+    double a, dd;
+    const double cost = matches(measured[i].normal, measured[i].d, entry, &a, &dd) ? a / kMatchAngle + dd / kMatchDistance : 1e9;
+    if (cost <= 2.0 && (best < 0 || cost < best_cost))
+    {
+      best = static_cast<int>(i);
+      best_cost = cost;
+    }
+  }
+  return best < 0 ? "accepted, not in the map" : std::string("accepted, not in the map: ") + toString(first_sights[best]);
 }
 
 // Least-squares normal of the masked pixels; false with fewer than min_pixels of them.

@@ -75,6 +75,24 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
       if (angleError(p.normal, truth.normal) <= tolerance.angle &&
           distanceError(p.normal, p.d, truth.normal, truth.d) <= tolerance.distance)
         return "seen, one map plane with another surface";
+    // Why the map did not report it at first sight: how the frame plane on it voted.
+    const std::vector<FramePlane>& measured = detector.lastFramePlanes();
+    const std::vector<FirstSight>& first_sights = detector.map().lastFirstSights();
+    int nearest_measured = -1;
+    double nearest_measured_cost = 0.0;
+    for (size_t i = 0; i < measured.size() && i < first_sights.size(); ++i)
+    {
+      const double ea = angleError(measured[i].normal, truth.normal);
+      const double ed = distanceError(measured[i].normal, measured[i].d, truth.normal, truth.d);
+      const double cost = ea / tolerance.angle + ed / tolerance.distance;
+      if (ea <= tolerance.angle && ed <= tolerance.distance && (nearest_measured < 0 || cost < nearest_measured_cost))
+      {
+        nearest_measured = static_cast<int>(i);
+        nearest_measured_cost = cost;
+      }
+    }
+    if (nearest_measured >= 0)
+      return std::string("seen, not yet in the map: ") + toString(first_sights[nearest_measured]);
     return "seen, not yet in the map";
   }
   return std::string(toString(best->verdict)) + (best->parallel_search ? " (parallel search)" : "");

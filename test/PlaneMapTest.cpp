@@ -401,6 +401,65 @@ TEST(PlaneMap, AFittingRegionIsReportedAtFirstSightOnlyWhenPrecise)
   }
 }
 
+// Each frame plane says how it voted, and the map's first-sight reports follow it: only a
+// complete measurement of a new surface is reported from this one frame.
+TEST(PlaneMap, EachFramePlaneSaysHowItVotedAtFirstSight)
+{
+  Map m;
+  FramePlane wall = m.plane(Eigen::Vector3d(1, 0, 0), -2.0, 20000);
+  wall.fits_its_blocks = true;
+  wall.normal_sigma = 0.002;
+  wall.offset_sigma = 0.001;
+  wall.centroid = Eigen::Vector3d(2.0, 0.0, 1.0);
+  m.frame({wall}, 0.0);
+  ASSERT_EQ(m.map.lastFirstSights(), std::vector<FirstSight>{FirstSight::kComplete});
+
+  // New faces 3,000 points strong (1.19 by their points alone), each in its own direction.
+  auto face = [&](double yaw, bool fits, double normal_sigma) {
+    const Eigen::Vector3d normal(std::cos(yaw), std::sin(yaw), 0.0);
+    const Eigen::Vector3d centroid = 3.0 * normal + Eigen::Vector3d(0.0, 0.0, 1.0);
+    FramePlane p = m.plane(normal, -normal.dot(centroid), 3000);
+    p.blocks = {1, 2, 3};
+    p.fits_its_blocks = fits;
+    p.normal_sigma = normal_sigma;
+    p.offset_sigma = 0.001;
+    p.centroid = centroid;
+    return p;
+  };
+  FramePlane mixing = face(2.0, false, 0.002);
+  mixing.mixes_surfaces = true;
+  FramePlane small = face(2.5, true, 0.002);
+  small.support = small.first_sight_points = m.params.min_support;
+  // Turned 0.08 rad about a point on the wall: possibly the wall measured badly.
+  const Eigen::Vector3d turned(std::cos(0.08), std::sin(0.08), 0.0);
+  FramePlane near_wall = face(0.0, true, 0.002);
+  near_wall.normal = turned;
+  near_wall.centroid = Eigen::Vector3d(2.0, 0.0, 1.0);
+  near_wall.d = -turned.dot(near_wall.centroid);
+  near_wall.hough = m.param.toHough(near_wall.normal, near_wall.d);
+  // The parallel search's planes have no blocks: by support alone, 1.25 for 1,000 weighted points.
+  FramePlane parallel_search = face(-2.0, false, 0.0);
+  parallel_search.blocks.clear();
+  parallel_search.parallel = true;
+  parallel_search.first_sight_points = 1000;
+  const std::vector<FramePlane> planes{wall, mixing, small, face(1.0, true, 0.002), face(1.5, false, 0.002),
+                                       face(-1.0, true, 0.02), near_wall, parallel_search};
+  m.frame(planes, 0.1);
+  const std::vector<FirstSight> expected{FirstSight::kKnownPlane,     FirstSight::kMixesSurfaces,
+                                         FirstSight::kTooSmall,       FirstSight::kComplete,
+                                         FirstSight::kNotFittingItsBlocks, FirstSight::kImprecise,
+                                         FirstSight::kNearKnownPlane, FirstSight::kWithoutBlocks};
+  ASSERT_EQ(m.map.lastFirstSights().size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i)
+  {
+    EXPECT_EQ(m.map.lastFirstSights()[i], expected[i])
+        << "plane " << i << ": " << toString(m.map.lastFirstSights()[i]) << ", expected " << toString(expected[i]);
+    if (i == 0) continue;
+    EXPECT_EQ(matching(m.map.planes(), planes[i].normal).size(), expected[i] == FirstSight::kComplete ? 1u : 0u)
+        << "plane " << i << " (" << toString(expected[i]) << ")";
+  }
+}
+
 // A precise new face near a known plane waits for a second frame only when it could be that
 // plane measured badly: turned 0.08 rad (under three merge angles) about a point on the known
 // wall it waits; the same turn 20 cm in front of the wall and 3 m along it (offsets 3 cm apart

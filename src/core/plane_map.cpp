@@ -39,6 +39,7 @@ void PlaneMap::clear()
   frame_count_ = 0;
   global_.clear();
   planes_.clear();
+  first_sights_.clear();
   next_id_ = 0;
 }
 
@@ -68,9 +69,11 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
   // judged by its peak's height, not by its nearest cell, which reads 1.37-2 by where it fell.
   std::vector<Eigen::Vector3i> seeds;
   std::vector<char> full_height;
-  for (const FramePlane& plane : frame_planes)
+  first_sights_.resize(frame_planes.size());
+  for (size_t i = 0; i < frame_planes.size(); ++i)
   {
-    const float weight = voteWeight(plane, frame_planes, dropped);
+    const FramePlane& plane = frame_planes[i];
+    const float weight = voteWeight(plane, frame_planes, dropped, first_sights_[i]);
     full_height.push_back(weight >= 2.0f);
     addVote(plane.hough, weight, cap);
     seeds.push_back(nearestCell(param_.toCell(plane.hough)));
@@ -364,7 +367,7 @@ void PlaneMap::thin(float cap, const std::vector<FramePlane>& frame_planes)
 }
 
 float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes,
-                           const std::vector<char>& dropped) const
+                           const std::vector<char>& dropped, FirstSight& first_sight) const
 {
   // A plane not yet in the map adds up to 2 when strongly supported, so that a big plane is
   // reported the first time it is seen, while known planes gain 1 per frame as in the paper
@@ -376,13 +379,19 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // front), and its offset is none of theirs. One of under 2 min_support points is too
   // small for the curvature tests: it waits for a second frame, unless it is parallel and its
   // weighted points reach the full bar (a box top near the sensor).
+  first_sight = FirstSight::kKnownPlane;
   for (const DetectedPlane& known : planes_)
     if (samePlane(known, plane)) return 1.0f;
+  first_sight = FirstSight::kTooSmall;  // every new plane is, with first-sight reports off
   if (params_.strong_support <= 0) return 1.0f;
   // A region whose blocks lie off its plane beyond their noise is no measurement of one
   // surface, however large: it does not vote. A second frame from nearly the same view grows
   // the same mixture (stair treads with the ramp beside them), so repeating it proves nothing.
-  if (plane.mixes_surfaces) return 0.0f;
+  if (plane.mixes_surfaces)
+  {
+    first_sight = FirstSight::kMixesSurfaces;
+    return 0.0f;
+  }
   const double strong_support = params_.strong_support * std::max(1.0, params_.sensor_noise * params_.sensor_noise);
   // Whether a surface is too small for the curvature tests does not depend on how many regions
   // the frame grew on it (a box top split in two): that test pools the points and support of
@@ -403,10 +412,40 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // precise enough that a second measurement would agree with it. Near a known plane it may be
   // that plane measured badly, and waits for a second frame; not near one this frame's
   // measurements just replaced.
-  if (plane.fits_its_blocks && preciseAtFirstSight(plane) && !nearKnownPlane(plane, dropped)) return 2.0f;
+  if (!plane.fits_its_blocks)
+    first_sight = plane.blocks.empty() ? FirstSight::kWithoutBlocks : FirstSight::kNotFittingItsBlocks;
+  else if (!preciseAtFirstSight(plane))
+    first_sight = FirstSight::kImprecise;
+  else
+    first_sight = nearKnownPlane(plane, dropped) ? FirstSight::kNearKnownPlane : FirstSight::kComplete;
+  if (first_sight == FirstSight::kComplete) return 2.0f;
   const bool offset_only = plane.parallel && (plane.blocks.empty() || plane.fits_its_blocks);
   const double bar = offset_only ? 0.25 * strong_support : strong_support;
   return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
+}
+
+const char* toString(FirstSight first_sight)
+{
+  switch (first_sight)
+  {
+    case FirstSight::kKnownPlane:
+      return "a map plane's";
+    case FirstSight::kMixesSurfaces:
+      return "mixes surfaces";
+    case FirstSight::kTooSmall:
+      return "too small to report at first sight";
+    case FirstSight::kComplete:
+      return "complete at first sight";
+    case FirstSight::kWithoutBlocks:
+      return "measured without blocks (parallel search or windows)";
+    case FirstSight::kNotFittingItsBlocks:
+      return "does not fit its blocks";
+    case FirstSight::kImprecise:
+      return "imprecise at first sight";
+    case FirstSight::kNearKnownPlane:
+      return "near a map plane";
+  }
+  return "unknown";
 }
 
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const

@@ -43,6 +43,21 @@ struct SnapTilts
   int64_t measurements = 0;
 };
 
+// How a frame's plane voted (PlaneMap::voteWeight): as a re-measurement of a map plane, as a
+// complete measurement of a new surface (reported at first sight), or why it was not one.
+enum class FirstSight
+{
+  kKnownPlane,           // on a map plane within the merge tolerances: weight 1
+  kMixesSurfaces,        // its blocks lie off it beyond their noise: weight 0
+  kTooSmall,             // too few points for the curvature tests: weight 1
+  kComplete,             // fits its blocks, precise, no map plane near: weight 2
+  kWithoutBlocks,        // by support alone (1 to 2), since: measured without blocks to test
+  kNotFittingItsBlocks,  //   ... its blocks do not pass the noise tests of a plane
+  kImprecise,            //   ... a second measurement could fall beyond the merge tolerances
+  kNearKnownPlane,       //   ... it may be a map plane near it measured badly
+};
+const char* toString(FirstSight first_sight);
+
 class PlaneMap
 {
 public:
@@ -68,6 +83,8 @@ public:
                double stamp);
 
   const std::vector<DetectedPlane>& planes() const { return planes_; }
+  // How each plane of the last accumulate's frame voted (same order as its frame planes).
+  const std::vector<FirstSight>& lastFirstSights() const { return first_sights_; }
   const SparseHoughSpace& space() const { return global_; }
   size_t chunksEvictedTotal() const { return chunks_evicted_total_; }
   // Map planes with snapped measurements pooled (reseatRefutedSnaps).
@@ -124,9 +141,9 @@ private:
   // centroids lie farther apart along their normal than their offsets' errors and a face's warp allow.
   bool distinctSurfaces(const FramePlane& a, const FramePlane& b) const;
   // What a frame plane adds to the space: 1, or up to 2 when strong and not yet in the map
-  // (the planes flagged in `dropped` are no longer in it).
+  // (the planes flagged in `dropped` are no longer in it); `first_sight` says which case.
   float voteWeight(const FramePlane& plane, const std::vector<FramePlane>& frame_planes,
-                   const std::vector<char>& dropped) const;
+                   const std::vector<char>& dropped, FirstSight& first_sight) const;
   // The space's peaks as the new plane list, ids carried over from the closest previous plane.
   void matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp);
   // Beliefs follow the ids: new planes start afresh, planes that left the map take theirs along.
@@ -164,6 +181,7 @@ private:
   std::unordered_map<int, PlaneExtent> extents_;
   std::unordered_map<int, PlaneBelief> beliefs_;  // forgetting by evidence, by plane id
   std::unordered_map<int, SnapTilts> snap_tilts_;  // by plane id
+  std::vector<FirstSight> first_sights_;           // of the last accumulate's frame planes
   int64_t frame_count_ = 0;          // frames since the map began (extents fade by it)
   size_t chunks_evicted_total_ = 0;  // chunks freed by the max_chunks cap since the map began
   int next_id_ = 0;
