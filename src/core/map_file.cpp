@@ -339,6 +339,7 @@ bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
   extents_.swap(extents);
   beliefs_.swap(beliefs);
   snap_tilts_.swap(snap_tilts);
+  first_sights_.clear();  // of a frame before the load: no frame of this map
   next_id_ = next_id;
   frame_count_ = frame_count;
   return true;
