@@ -661,4 +661,8 @@ TEST(PlaneMap, SerialisesToItselfExactly)
   EXPECT_FALSE(restored.map.deserialize(broken, &error));
   EXPECT_NE(error.find("checksum"), std::string::npos) << error;
   EXPECT_EQ(restored.map.serialize(), m.map.serialize());
+  // How the last frame voted belongs to that frame, not to a map loaded after it.
+  ASSERT_EQ(restored.map.lastFirstSights().size(), 1u);
+  ASSERT_TRUE(restored.map.deserialize(bytes, &error)) << error;
+  EXPECT_TRUE(restored.map.lastFirstSights().empty());
 }
