@@ -31,6 +31,19 @@ struct Map
     p.first_sight_points = first_sight_points < 0.0 ? support : first_sight_points;
     return p;
   }
+  // A region that fits its blocks, measured at `centroid` with the given normal's sigma and an
+  // offset sigma of 1 mm.
+  FramePlane fitting(const Eigen::Vector3d& normal, const Eigen::Vector3d& centroid, double support,
+                     double normal_sigma = 0.002) const
+  {
+    FramePlane p = plane(normal, -normal.normalized().dot(centroid), support);
+    p.blocks = {1, 2, 3};
+    p.fits_its_blocks = true;
+    p.normal_sigma = normal_sigma;
+    p.offset_sigma = 0.001;
+    p.centroid = centroid;
+    return p;
+  }
   void frame(const std::vector<FramePlane>& planes, double stamp,
              const Eigen::Vector3d& camera_position = Eigen::Vector3d::Zero())
   {
@@ -406,24 +419,15 @@ TEST(PlaneMap, AFittingRegionIsReportedAtFirstSightOnlyWhenPrecise)
 TEST(PlaneMap, EachFramePlaneSaysHowItVotedAtFirstSight)
 {
   Map m;
-  FramePlane wall = m.plane(Eigen::Vector3d(1, 0, 0), -2.0, 20000);
-  wall.fits_its_blocks = true;
-  wall.normal_sigma = 0.002;
-  wall.offset_sigma = 0.001;
-  wall.centroid = Eigen::Vector3d(2.0, 0.0, 1.0);
+  const FramePlane wall = m.fitting(Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2.0, 0.0, 1.0), 20000);
   m.frame({wall}, 0.0);
   ASSERT_EQ(m.map.lastFirstSights(), std::vector<FirstSight>{FirstSight::kComplete});
 
   // New faces 3,000 points strong (1.19 by their points alone), each in its own direction.
   auto face = [&](double yaw, bool fits, double normal_sigma) {
     const Eigen::Vector3d normal(std::cos(yaw), std::sin(yaw), 0.0);
-    const Eigen::Vector3d centroid = 3.0 * normal + Eigen::Vector3d(0.0, 0.0, 1.0);
-    FramePlane p = m.plane(normal, -normal.dot(centroid), 3000);
-    p.blocks = {1, 2, 3};
+    FramePlane p = m.fitting(normal, 3.0 * normal + Eigen::Vector3d(0.0, 0.0, 1.0), 3000, normal_sigma);
     p.fits_its_blocks = fits;
-    p.normal_sigma = normal_sigma;
-    p.offset_sigma = 0.001;
-    p.centroid = centroid;
     return p;
   };
   FramePlane mixing = face(2.0, false, 0.002);
@@ -431,12 +435,8 @@ TEST(PlaneMap, EachFramePlaneSaysHowItVotedAtFirstSight)
   FramePlane small = face(2.5, true, 0.002);
   small.support = small.first_sight_points = m.params.min_support;
   // Turned 0.08 rad about a point on the wall: possibly the wall measured badly.
-  const Eigen::Vector3d turned(std::cos(0.08), std::sin(0.08), 0.0);
-  FramePlane near_wall = face(0.0, true, 0.002);
-  near_wall.normal = turned;
-  near_wall.centroid = Eigen::Vector3d(2.0, 0.0, 1.0);
-  near_wall.d = -turned.dot(near_wall.centroid);
-  near_wall.hough = m.param.toHough(near_wall.normal, near_wall.d);
+  const FramePlane near_wall =
+      m.fitting(Eigen::Vector3d(std::cos(0.08), std::sin(0.08), 0.0), Eigen::Vector3d(2.0, 0.0, 1.0), 3000);
   // The parallel search's planes have no blocks: by support alone, 1.25 for 1,000 weighted points.
   FramePlane parallel_search = face(-2.0, false, 0.0);
   parallel_search.blocks.clear();
@@ -471,18 +471,10 @@ TEST(PlaneMap, ANewFaceWaitsOnlyWhereAKnownPlanePassesItsPoints)
   {
     const bool on_wall = centroid.x() == 2.0;
     Map m;
-    FramePlane wall = m.plane(Eigen::Vector3d(1, 0, 0), -2.0, 20000);
-    wall.fits_its_blocks = true;
-    wall.normal_sigma = 0.002;
-    wall.offset_sigma = 0.001;
-    wall.centroid = Eigen::Vector3d(2.0, 0.0, 1.0);
+    const FramePlane wall = m.fitting(Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2.0, 0.0, 1.0), 20000);
     m.frame({wall}, 0.0);
     ASSERT_EQ(m.map.planes().size(), 1u);
-    FramePlane face = m.plane(turned, -turned.dot(centroid), 3000);
-    face.fits_its_blocks = true;
-    face.normal_sigma = 0.002;
-    face.offset_sigma = 0.001;
-    face.centroid = centroid;
+    const FramePlane face = m.fitting(turned, centroid, 3000);
     m.frame({wall, face}, 0.1);
     EXPECT_EQ(matching(m.map.planes(), turned).size(), on_wall ? 0u : 1u)
         << "face centred at (" << centroid.transpose() << "), offset at the origin "
