@@ -38,11 +38,9 @@ TEST(BagPlayback, NodeletOnAPlayedBagMatchesTheOfflineTool)
   PlaneArrayRecorder recorder;
   ASSERT_TRUE(waitUntil([&] { return recorder.connected() && hasSubscriber("/camera/depth/points"); }, 60.0))
       << "the detector never subscribed to /camera/depth/points";
-  // -d: rosbag's new publisher is connected to by the detector before the first cloud.
-  const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 2 " + bag, &code);
-  ASSERT_EQ(code, 0) << played;
   const double last_stamp = 100.0 + 0.1 * (frames - 1);
-  waitUntil([&] { return recorder.receivedStamp(last_stamp); }, 60.0);
+  playBagUntil(bag, [&] { return recorder.receivedStamp(last_stamp); }, 60.0, &code);
+  ASSERT_EQ(code, 0) << "rosbag play failed on " << bag;
 
   const std::vector<PlaneArray::ConstPtr> received = recorder.received();
   std::string stamps;

@@ -32,11 +32,9 @@ TEST(DepthImage, ATumStyleBagGivesTheRoomsPlanes)
       60.0))
       << "the detector and depth_image_proc never subscribed";
   int code = 0;
-  // -d: rosbag's new publishers are connected to by the subscribers before the first message.
-  const std::string played = runCommand("/usr/lib/rosbag/play --clock -d 2 " + bag, &code);
-  ASSERT_EQ(code, 0) << played;
   const double last_stamp = kTumStart + (kTumFrames - 1) / 30.0;
-  waitUntil([&] { return recorder.receivedStamp(last_stamp); }, 60.0);
+  playBagUntil(bag, [&] { return recorder.receivedStamp(last_stamp); }, 60.0, &code);
+  ASSERT_EQ(code, 0) << "rosbag play failed on " << bag;
 
   const std::vector<PlaneArray::ConstPtr> received = recorder.received();
   ASSERT_FALSE(received.empty()) << "no plane array: the depth images never became clouds the detector took";

@@ -2,7 +2,9 @@
 // parsing of detect_planes' JSON lines.
 #pragma once
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
@@ -226,6 +228,32 @@ inline std::string runCommand(const std::string& command, int* exit_code)
   const int status = pipe ? pclose(pipe) : -1;
   *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return output;
+}
+
+// Plays `bag` with its clock, its publishers connected to before the first message (-d 2), and
+// keeps them up (-k) until `done` holds or `seconds` pass, then stops the player. When rosbag
+// play exits by itself it can drop the messages still queued for a subscriber: on a busy
+// machine the last cloud's transform was lost and with it the last frame. Returns whether
+// `done` held and, in `exit_code`, the player's (0: it stopped as asked).
+template <class Done>
+bool playBagUntil(const std::string& bag, Done done, double seconds, int* exit_code)
+{
+  const pid_t player = fork();
+  if (player == 0)
+  {
+    execl("/usr/lib/rosbag/play", "play", "--clock", "-d", "2", "-k", "-q", bag.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const bool held = player > 0 && waitUntil(done, seconds);
+  int status = 0;
+  if (player > 0)
+  {
+    kill(player, SIGINT);
+    waitpid(player, &status, 0);
+  }
+  // rosbag play ends on SIGINT with 0, or is killed by it before its handler is installed.
+  *exit_code = player > 0 && (WIFEXITED(status) || WIFSIGNALED(status)) ? (WIFEXITED(status) ? WEXITSTATUS(status) : 0) : -1;
+  return held;
 }
 
 struct JsonPlane
