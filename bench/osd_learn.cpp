@@ -144,8 +144,9 @@ std::string missReason(const PlaneDetector& detector, const Entry& entry)
   for (size_t i = 0; i < measured.size() && i < first_sights.size(); ++i)
   {
     double a, dd;
-    const double cost = matches(measured[i].normal, measured[i].d, entry, &a, &dd) ? a / kMatchAngle + dd / kMatchDistance : 1e9;
-    if (cost <= 2.0 && (best < 0 || cost < best_cost))
+    if (!matches(measured[i].normal, measured[i].d, entry, &a, &dd)) continue;
+    const double cost = a / kMatchAngle + dd / kMatchDistance;
+    if (best < 0 || cost < best_cost)
     {
       best = static_cast<int>(i);
       best_cost = cost;
