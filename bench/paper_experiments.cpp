@@ -36,6 +36,23 @@ DetectorParams paramsFor(double noise, int resolution)
   return p;
 }
 
+namespace
+{
+// How far a plane lies from a true one in units of the match tolerance (angle / tolerance.angle
+// + distance / tolerance.distance), and whether it is within both tolerances.
+struct MatchCost
+{
+  double cost;
+  bool within;
+};
+
+MatchCost matchCost(const Eigen::Vector3d& normal, double d, const TruePlane& truth, const MatchTolerance& tolerance)
+{
+  const double ea = angleError(normal, truth.normal), ed = distanceError(normal, d, truth.normal, truth.d);
+  return {ea / tolerance.angle + ed / tolerance.distance, ea <= tolerance.angle && ed <= tolerance.distance};
+}
+}  // namespace
+
 std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
 {
   const MatchTolerance tolerance;
@@ -44,9 +61,7 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
   double best_cost = 0.0, nearest_cost = 0.0;
   for (const PlaneCandidate& c : detector.lastCandidates())
   {
-    const double ea = angleError(c.normal, truth.normal), ed = distanceError(c.normal, c.d, truth.normal, truth.d);
-    const double cost = ea / tolerance.angle + ed / tolerance.distance;
-    const bool within = ea <= tolerance.angle && ed <= tolerance.distance;
+    const auto [cost, within] = matchCost(c.normal, c.d, truth, tolerance);
     if (within && (!best || cost < best_cost))
     {
       best = &c;
@@ -72,9 +87,7 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
     // A map plane within the tolerance that the one-to-one matching gave to another true plane:
     // the map holds the two surfaces as one plane.
     for (const DetectedPlane& p : detector.planes())
-      if (angleError(p.normal, truth.normal) <= tolerance.angle &&
-          distanceError(p.normal, p.d, truth.normal, truth.d) <= tolerance.distance)
-        return "seen, one map plane with another surface";
+      if (matchCost(p.normal, p.d, truth, tolerance).within) return "seen, one map plane with another surface";
     // Why the map did not report it at first sight: how the frame plane on it voted.
     const std::vector<FramePlane>& measured = detector.lastFramePlanes();
     const std::vector<FirstSight>& first_sights = detector.map().lastFirstSights();
@@ -82,10 +95,8 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
     double nearest_measured_cost = 0.0;
     for (size_t i = 0; i < measured.size() && i < first_sights.size(); ++i)
     {
-      const double ea = angleError(measured[i].normal, truth.normal);
-      const double ed = distanceError(measured[i].normal, measured[i].d, truth.normal, truth.d);
-      const double cost = ea / tolerance.angle + ed / tolerance.distance;
-      if (ea <= tolerance.angle && ed <= tolerance.distance && (nearest_measured < 0 || cost < nearest_measured_cost))
+      const auto [cost, within] = matchCost(measured[i].normal, measured[i].d, truth, tolerance);
+      if (within && (nearest_measured < 0 || cost < nearest_measured_cost))
       {
         nearest_measured = static_cast<int>(i);
         nearest_measured_cost = cost;

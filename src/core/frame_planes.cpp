@@ -457,7 +457,6 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
     auto distance = [&](int block, int part) {
       return normals[part].dot(frame_.blocks[block].centroid) + offsets[part];
     };
-    auto variance = [&](int block) { return frame_.blocks[block].centroid_variance + kCentroidFloor; };
     auto touches = [&](int block, int part) {
       bool touching = false;
       forEachNeighbour(block, bx_count, by_count, [&](int neighbour) { touching |= owner[neighbour] == part; });
@@ -471,7 +470,7 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
         if (owner[block] >= 0) continue;
         const int nearer = std::abs(distance(block, 0)) <= std::abs(distance(block, 1)) ? 0 : 1;
         for (int part : {nearer, 1 - nearer})
-          if (touches(block, part) && std::pow(distance(block, part), 2) <= 9.0 * variance(block))
+          if (touches(block, part) && std::pow(distance(block, part), 2) <= 9.0 * tests_.centroidVariance(block))
           {
             owner[block] = static_cast<signed char>(part);
             grew = true;
@@ -493,7 +492,7 @@ bool FramePlaneFitter::splitMixedRegion(const BlockRegionGrower& grower, const P
         continue;
       }
       ++left_out[in_a[block] ? 0 : 1];
-      left_out_chi2 += std::min(std::pow(distance(block, 0), 2), std::pow(distance(block, 1), 2)) / variance(block);
+      left_out_chi2 += std::min(std::pow(distance(block, 0), 2), std::pow(distance(block, 1), 2)) / tests_.centroidVariance(block);
     }
     if (left_out[0] > kMaxLeftOutShare * a.size() || left_out[1] > kMaxLeftOutShare * b.size()) return -1.0;
     if (pieces[0].size() < kMinInteriorBlocks || pieces[1].size() < kMinInteriorBlocks) return -1.0;
@@ -638,7 +637,7 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   {
     const BlockInfo& info = frame_.blocks[b];
     const double offset = -n_cam.dot(info.centroid);
-    if (std::abs(offset - median) > 3.0 * std::sqrt(info.centroid_variance + kCentroidFloor)) continue;
+    if (std::abs(offset - median) > 3.0 * std::sqrt(tests_.centroidVariance(b))) continue;
     inliers.push_back(b);
     inlier_points += points(b);
     weight_sum += info.fit_weight;

@@ -54,7 +54,7 @@ bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, s
   for (size_t i = begin; i < end; ++i)
   {
     const PointMoments moments = centroidMoments(frame_.moments(blocks[i]));
-    centroids.push_back({moments, moments.mean(), frame_.blocks[blocks[i]].centroid_variance + kCentroidFloor});
+    centroids.push_back({moments, moments.mean(), centroidVariance(blocks[i])});
     all.add(moments);
   }
   if (all.count < 3) return true;
@@ -365,7 +365,7 @@ double PlanarityTests::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, 
   {
     const BlockInfo& info = frame_.blocks[b];
     const double distance = n_cam.dot(info.centroid) + d_cam;
-    chi2 += distance * distance / (info.centroid_variance + kCentroidFloor);
+    chi2 += distance * distance / centroidVariance(b);
   }
   return blocks.empty() ? 0.0 : chi2 / blocks.size();
 }

@@ -109,8 +109,9 @@ public:
   // a block across an edge or a step is thicker. Never beyond the block's thickness_limit;
   // without a noise model, that limit alone.
   bool isThinAlong(int block, const Eigen::Vector3d& n_cam) const;
-  // A block centroid's inverse variance about its true plane (its noise and kCentroidFloor).
-  double centroidWeight(int block) const { return 1.0 / (frame_.blocks[block].centroid_variance + kCentroidFloor); }
+  // A block centroid's variance about its true plane (its noise and kCentroidFloor), and its inverse.
+  double centroidVariance(int block) const { return frame_.blocks[block].centroid_variance + kCentroidFloor; }
+  double centroidWeight(int block) const { return 1.0 / centroidVariance(block); }
   // Mean chi^2 of the block centroids about a camera-frame plane.
   double centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const;
   // True when the blocks' own fit is within 2 merge_angle of the camera-frame normal.
