@@ -460,6 +460,61 @@ TEST(PlaneMap, EachFramePlaneSaysHowItVotedAtFirstSight)
   }
 }
 
+// Snapped new faces that took one known direction in one frame (a staircase's risers) measure
+// it together: three risers each too imprecise alone (sigma 0.022 rad) are reported at first
+// sight when their own normals agree with it and with each other, not one alone, not one whose
+// only companion is a map plane measured again, not two whose own normals lie apart beyond
+// their noise, and not four whose pooled normal refutes the known one.
+TEST(PlaneMap, SnappedFacesSharingADirectionMeasureItTogether)
+{
+  const Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  const double sigma = 0.022;
+  auto riser = [&](const Map& m, double x, double tilt, double own_sigma = 0.022) {
+    FramePlane p = m.fitting(direction, Eigen::Vector3d(x, 0.0, 0.5), 3000, own_sigma);
+    p.parallel = true;
+    p.first_sight_points = 1000;  // by support alone 1.25, under global_threshold
+    p.own_normal = Eigen::Vector3d(std::cos(tilt), std::sin(tilt), 0.0);
+    p.own_normal_information =
+        (Eigen::Matrix3d::Identity() - direction * direction.transpose()) / (own_sigma * own_sigma);
+    return p;
+  };
+  auto firstSights = [](Map& m, const std::vector<FramePlane>& planes, double stamp) {
+    m.frame(planes, stamp);
+    return m.map.lastFirstSights();
+  };
+  {
+    Map m;
+    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.01), riser(m, 1.3, -0.01), riser(m, 1.6, 0.0)}, 0.0),
+              std::vector<FirstSight>(3, FirstSight::kComplete));
+    EXPECT_EQ(matching(m.map.planes(), direction).size(), 3u);
+  }
+  {
+    Map m;
+    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.01)}, 0.0), std::vector<FirstSight>{FirstSight::kImprecise});
+    EXPECT_TRUE(m.map.planes().empty());
+  }
+  {
+    Map m;
+    const FramePlane wall = m.fitting(direction, Eigen::Vector3d(3.0, 0.0, 1.0), 20000);
+    m.frame({wall}, 0.0);
+    const FramePlane wall_again = riser(m, 3.0, 0.0, 0.002);
+    EXPECT_EQ(firstSights(m, {wall_again, riser(m, 1.0, 0.01)}, 0.1),
+              (std::vector<FirstSight>{FirstSight::kKnownPlane, FirstSight::kImprecise}));
+  }
+  {
+    Map m;  // each 2.3 sigmas off the known normal, 3.2 sigmas of their difference apart
+    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.05), riser(m, 1.3, -0.05)}, 0.0),
+              std::vector<FirstSight>(2, FirstSight::kImprecise));
+  }
+  {
+    Map m;  // each 1.6 sigmas off, together 3.2 of their pooled sigma
+    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.035), riser(m, 1.3, 0.035), riser(m, 1.6, 0.035), riser(m, 1.9, 0.035)},
+                          0.0),
+              std::vector<FirstSight>(4, FirstSight::kImprecise));
+  }
+  EXPECT_GT(2.0 * M_SQRT2 * sigma, DetectorParams().merge_angle);  // imprecise alone
+}
+
 // A precise new face near a known plane waits for a second frame only when it could be that
 // plane measured badly: turned 0.08 rad (under three merge angles) about a point on the known
 // wall it waits; the same turn 20 cm in front of the wall and 3 m along it (offsets 3 cm apart

@@ -5,6 +5,9 @@
 #include <functional>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+#include <boost/math/distributions/chi_squared.hpp>
+
 #include "hough_plane_detector/core/block_regions.h"
 #include "hough_plane_detector/core/plane_geometry.h"
 
@@ -414,7 +417,7 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // measurements just replaced.
   if (!plane.fits_its_blocks)
     first_sight = plane.blocks.empty() ? FirstSight::kWithoutBlocks : FirstSight::kNotFittingItsBlocks;
-  else if (!preciseAtFirstSight(plane))
+  else if (!preciseAtFirstSight(plane, frame_planes))
     first_sight = FirstSight::kImprecise;
   else
     first_sight = nearKnownPlane(plane, dropped) ? FirstSight::kNearKnownPlane : FirstSight::kComplete;
@@ -448,14 +451,72 @@ const char* toString(FirstSight first_sight)
   return "unknown";
 }
 
+namespace
+{
+// Two measurements of one surface differ by sqrt(2) sigma; a tolerance holds at 2 sigma of that
+// difference.
+constexpr double kFirstSightSigmas = 2.0 * M_SQRT2;
+}  // namespace
+
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 {
-  // Two measurements of one surface differ by sqrt(2) sigma; both tolerances hold at 2 sigma
-  // of that difference. The offset is judged where the surface was measured, at its points: a
-  // far face's small tilt error moves its offset at the world origin, not the surface shown.
-  constexpr double kSigmas = 2.0 * M_SQRT2;
-  return kSigmas * measured.normal_sigma <= params_.merge_angle &&
-         kSigmas * measured.offset_sigma <= params_.merge_distance;
+  // The offset is judged where the surface was measured, at its points: a far face's small
+  // tilt error moves its offset at the world origin, not the surface shown.
+  return kFirstSightSigmas * measured.normal_sigma <= params_.merge_angle &&
+         kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance;
+}
+
+bool PlaneMap::preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const
+{
+  if (preciseAtFirstSight(measured)) return true;
+  return measured.parallel && kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance &&
+         kFirstSightSigmas * sharedDirectionSigma(measured, frame_planes) <= params_.merge_angle;
+}
+
+double PlaneMap::sharedDirectionSigma(const FramePlane& snapped, const std::vector<FramePlane>& frame_planes) const
+{
+  // Surfaces that took one known direction in one frame (the risers of a staircase) are
+  // parallel if the snaps are right, so their own normals measure that one direction together:
+  // each tilt t_i off it, with information I_i, pools to t = (sum I_i)^-1 sum I_i t_i. The
+  // direction is confirmed when t is within the pooled noise (chi^2, 2 dof) and the tilts
+  // scatter about t no more than their noise (chi^2, 2 (k - 1) dof). A map plane measured again
+  // is no member: its precise normal would vouch for any face that snapped to it.
+  constexpr double kSameDirection = 1e-4;  // rad: snapped planes carry the known normal exactly
+  constexpr double kP = 0.01;
+  const double infinite = std::numeric_limits<double>::infinity();
+  if (!snapped.parallel || snapped.own_normal.isZero()) return infinite;
+  const Eigen::Vector3d& direction = snapped.normal;
+  Eigen::Matrix<double, 3, 2> tangent;
+  tangent << direction.unitOrthogonal(), direction.cross(direction.unitOrthogonal());
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d weighted_tilt = Eigen::Vector2d::Zero();
+  double chi2_each = 0.0;
+  int members = 0;
+  for (const FramePlane& other : frame_planes)
+  {
+    if (!other.parallel || other.own_normal.isZero() || !other.fits_its_blocks ||
+        unsignedAngle(other.normal, direction) > kSameDirection)
+      continue;
+    if (std::any_of(planes_.begin(), planes_.end(), [&](const DetectedPlane& known) { return samePlane(known, other); }))
+      continue;
+    const Eigen::Vector3d own = other.own_normal.dot(direction) >= 0.0 ? other.own_normal : -other.own_normal;
+    const Eigen::Vector2d tilt = tangent.transpose() * (own - direction);
+    const Eigen::Matrix2d own_information = tangent.transpose() * other.own_normal_information * tangent;
+    information += own_information;
+    weighted_tilt += own_information * tilt;
+    chi2_each += tilt.dot(own_information * tilt);
+    ++members;
+  }
+  if (members < 2) return infinite;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(information);
+  if (!(eigen.eigenvalues()(0) > 0.0)) return infinite;
+  const Eigen::Vector2d pooled_tilt = information.ldlt().solve(weighted_tilt);
+  const double chi2_pooled = pooled_tilt.dot(information * pooled_tilt);
+  const boost::math::chi_squared scatter(2.0 * (members - 1));
+  if (chi2_pooled > kMaxSnapChi2Increase ||
+      chi2_each - chi2_pooled > boost::math::quantile(boost::math::complement(scatter, kP)))
+    return infinite;
+  return 1.0 / std::sqrt(eigen.eigenvalues()(0));
 }
 
 std::vector<char> PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_planes)

@@ -120,6 +120,14 @@ private:
   // True when the frame's plane is precise enough that a second measurement of it falls within
   // the merge tolerances of it: its normal, and its offset at its own points.
   bool preciseAtFirstSight(const FramePlane& measured) const;
+  // The same, with a snapped plane's normal judged by every new surface of the frame that took
+  // the same known direction (sharedDirectionSigma): a staircase's risers, a shelf's boards.
+  bool preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const;
+  // The standard error (rad) of the direction that the snapped new planes of `frame_planes`
+  // sharing `snapped`'s known normal measure together: their own normals pooled by their
+  // information, when they agree with that normal and with each other (chi^2, p = 0.01).
+  // Infinity when they do not, or when `snapped` is alone.
+  double sharedDirectionSigma(const FramePlane& snapped, const std::vector<FramePlane>& frame_planes) const;
   // Clears the cells of one-frame planes this frame measured again elsewhere, nearby; flags
   // them, by index of planes_.
   std::vector<char> dropSuperseded(const std::vector<FramePlane>& frame_planes);
