@@ -544,8 +544,18 @@ std::vector<char> PlaneMap::dropSuperseded(const std::vector<FramePlane>& frame_
 
 bool PlaneMap::nearKnownPlane(const FramePlane& measured, const std::vector<char>& dropped) const
 {
+  // A bad measurement of a known surface turns about its centroid, which stays on that surface:
+  // a known plane that passes the centroid farther off than the measurement's offset noise and
+  // a face's warp allow (3 sigma, as distinctSurfaces) has another surface there (a shelf board
+  // 3.7 cm under a box top, its offset measured to 1.2 mm).
+  const double reach =
+      3.0 * std::sqrt(measured.offset_sigma * measured.offset_sigma + kSurfaceWarp * kSurfaceWarp);
   for (size_t p = 0; p < planes_.size(); ++p)
-    if (!dropped[p] && nearPlane(planes_[p], measured)) return true;
+  {
+    if (dropped[p] || !nearPlane(planes_[p], measured)) continue;
+    const double gap = std::abs(planes_[p].normal.dot(measured.centroid) + planes_[p].d);
+    if (!(measured.offset_sigma > 0.0 && gap > reach)) return true;
+  }
   return false;
 }
 

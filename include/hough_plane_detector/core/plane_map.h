@@ -113,9 +113,10 @@ private:
   // judged at the frame plane's centroid when known: more likely a noisy re-measurement of it
   // than a new surface.
   bool nearPlane(const DetectedPlane& known, const FramePlane& measured) const;
-  // True when a map plane is near the frame's plane (nearPlane), so it is not reported at first
-  // sight. Map planes flagged in `dropped` (this frame superseded them) do not count: the
-  // measurement is what replaced them.
+  // True when a map plane is near the frame's plane (nearPlane) and passes its points within
+  // their offset noise and a face's warp, so the frame's plane may be that plane measured badly
+  // and is not reported at first sight. Map planes flagged in `dropped` (this frame superseded
+  // them) do not count: the measurement is what replaced them.
   bool nearKnownPlane(const FramePlane& measured, const std::vector<char>& dropped) const;
   // True when the frame's plane is precise enough that a second measurement of it falls within
   // the merge tolerances of it: its normal, and its offset at its own points.
