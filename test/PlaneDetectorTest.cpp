@@ -285,9 +285,11 @@ TEST(PlaneDetector, TwoTableTopsCloserThanAHoughPeakStayTwoPlanes)
 }
 
 // A new panel 30 cm wide turned 0.08 rad off a known wall and 5 cm before it lies within three
-// merge tolerances of it: that may be the wall measured badly, so it is not reported at first
-// sight, while the same panel turned 0.3 rad is reported the first time a frame measures it.
-TEST(PlaneDetector, APlaneNearAKnownOneIsNotReportedAtFirstSight)
+// merge tolerances of it, but the wall passes its points 5 cm off, far beyond what its offset
+// noise and a face's warp allow: it is another surface, not the wall measured badly, and is
+// reported the first time a frame measures it, as the same panel turned 0.3 rad is. (A face the
+// known plane passes through waits: PlaneMap.ANewFaceWaitsOnlyWhereAKnownPlanePassesItsPoints.)
+TEST(PlaneDetector, APanelBeforeAKnownWallIsReportedAtFirstSight)
 {
   for (double turn : {0.08, 0.3})
   {
@@ -313,7 +315,7 @@ TEST(PlaneDetector, APlaneNearAKnownOneIsNotReportedAtFirstSight)
     do feed(detector, renderer.render(pose, kinect(1.0), frame), 0.1 * frame);
     while (!measured() && ++frame < 6);
     ASSERT_TRUE(measured()) << "turn " << turn;
-    EXPECT_EQ(matching(detector.planes(), panel_normal, panel_d, 0.05, 0.03).size(), turn > 0.1 ? 1u : 0u)
+    EXPECT_EQ(matching(detector.planes(), panel_normal, panel_d, 0.05, 0.03).size(), 1u)
         << "turn " << turn << " at its first sight" << describe(detector.planes());
   }
 }
