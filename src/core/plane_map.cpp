@@ -21,6 +21,12 @@ constexpr double kNearTolerances = 3.0;
 constexpr double kRefutedSnapChi2 = 13.82;
 // Camera displacement over the distance to a face below which two frames share a viewpoint.
 constexpr double kSameViewpoint = 8.0 / 580.0;
+// How far off one surface's measurements may pass each other's points: three sigmas of their
+// offsets' noise (the summed variance) and a face's warp.
+double surfaceReach(double offset_variance)
+{
+  return 3.0 * std::sqrt(offset_variance + kSurfaceWarp * kSurfaceWarp);
+}
 }  // namespace
 
 PlaneMap::PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
@@ -354,8 +360,7 @@ bool PlaneMap::distinctSurfaces(const FramePlane& a, const FramePlane& b) const
   const double sign = a.normal.dot(b.normal) >= 0.0 ? 1.0 : -1.0;
   const Eigen::Vector3d between = b.centroid - a.centroid;
   const double gap = std::abs((a.normal + sign * b.normal).normalized().dot(between));
-  const double allowed = 3.0 * std::sqrt(a.offset_sigma * a.offset_sigma + b.offset_sigma * b.offset_sigma +
-                                         kSurfaceWarp * kSurfaceWarp) +
+  const double allowed = surfaceReach(a.offset_sigma * a.offset_sigma + b.offset_sigma * b.offset_sigma) +
                          unsignedAngle(a.normal, b.normal) * between.norm();
   return gap > allowed;
 }
@@ -469,7 +474,7 @@ bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const
 {
   if (preciseAtFirstSight(measured)) return true;
-  return measured.parallel && kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance &&
+  return kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance &&
          kFirstSightSigmas * sharedDirectionSigma(measured, frame_planes) <= params_.merge_angle;
 }
 
@@ -548,8 +553,7 @@ bool PlaneMap::nearKnownPlane(const FramePlane& measured, const std::vector<char
   // a known plane that passes the centroid farther off than the measurement's offset noise and
   // a face's warp allow (3 sigma, as distinctSurfaces) has another surface there (a shelf board
   // 3.7 cm under a box top, its offset measured to 1.2 mm).
-  const double reach =
-      3.0 * std::sqrt(measured.offset_sigma * measured.offset_sigma + kSurfaceWarp * kSurfaceWarp);
+  const double reach = surfaceReach(measured.offset_sigma * measured.offset_sigma);
   for (size_t p = 0; p < planes_.size(); ++p)
   {
     if (dropped[p] || !nearPlane(planes_[p], measured)) continue;
