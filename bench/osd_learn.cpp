@@ -137,22 +137,11 @@ std::string missReason(const PlaneDetector& detector, const Entry& entry)
   for (const DetectedPlane& plane : detector.planes())
     if (matches(plane.normal, plane.d, entry)) return "accepted, one map plane with another entry";
   // Why the map did not report it at first sight: how the frame's plane on it voted.
-  const std::vector<FramePlane>& measured = detector.lastFramePlanes();
-  const std::vector<FirstSight>& first_sights = detector.map().lastFirstSights();
-  int best = -1;
-  double best_cost = 0.0;
-  for (size_t i = 0; i < measured.size() && i < first_sights.size(); ++i)
-  {
+  const FirstSight* first_sight = nearestFirstSight(detector, [&](const Eigen::Vector3d& n, double d) {
     double a, dd;
-    if (!matches(measured[i].normal, measured[i].d, entry, &a, &dd)) continue;
-    const double cost = a / kMatchAngle + dd / kMatchDistance;
-    if (best < 0 || cost < best_cost)
-    {
-      best = static_cast<int>(i);
-      best_cost = cost;
-    }
-  }
-  return best < 0 ? "accepted, not in the map" : std::string("accepted, not in the map: ") + toString(first_sights[best]);
+    return matches(n, d, entry, &a, &dd) ? a / kMatchAngle + dd / kMatchDistance : -1.0;
+  });
+  return first_sight ? std::string("accepted, not in the map: ") + toString(*first_sight) : "accepted, not in the map";
 }
 
 // Least-squares normal of the masked pixels; false with fewer than min_pixels of them.
@@ -482,6 +471,25 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
   results.methods = {single, copies};
   if (with_pcl) results.methods.insert(results.methods.end(), {ransac, organized});
   return true;
+}
+
+const FirstSight* nearestFirstSight(const PlaneDetector& detector,
+                                    const std::function<double(const Eigen::Vector3d& normal, double d)>& cost)
+{
+  const std::vector<FramePlane>& measured = detector.lastFramePlanes();
+  const std::vector<FirstSight>& first_sights = detector.map().lastFirstSights();
+  const FirstSight* nearest = nullptr;
+  double nearest_cost = 0.0;
+  for (size_t i = 0; i < measured.size() && i < first_sights.size(); ++i)
+  {
+    const double c = cost(measured[i].normal, measured[i].d);
+    if (c >= 0.0 && (!nearest || c < nearest_cost))
+    {
+      nearest = &first_sights[i];
+      nearest_cost = c;
+    }
+  }
+  return nearest;
 }
 
 std::string osdLearnMarkdown(const OsdResults& results, const std::string& picture_prefix)

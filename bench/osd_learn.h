@@ -4,6 +4,7 @@
 // annotations.json (a detection matches an entry within 0.06 rad and 3 cm).
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -14,6 +15,12 @@
 
 namespace hough_plane_detector
 {
+
+// How the last frame's plane nearest a target voted at first sight (PlaneMap::lastFirstSights):
+// of the frame's planes that `cost` scores (>= 0; negative: not within the match tolerance),
+// the one of least cost; nullptr when there is none.
+const FirstSight* nearestFirstSight(const PlaneDetector& detector,
+                                    const std::function<double(const Eigen::Vector3d& normal, double d)>& cost);
 
 struct OsdMethodResult
 {

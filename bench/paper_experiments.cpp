@@ -89,22 +89,11 @@ std::string missCause(const PlaneDetector& detector, const TruePlane& truth)
     for (const DetectedPlane& p : detector.planes())
       if (matchCost(p.normal, p.d, truth, tolerance).within) return "seen, one map plane with another surface";
     // Why the map did not report it at first sight: how the frame plane on it voted.
-    const std::vector<FramePlane>& measured = detector.lastFramePlanes();
-    const std::vector<FirstSight>& first_sights = detector.map().lastFirstSights();
-    int nearest_measured = -1;
-    double nearest_measured_cost = 0.0;
-    for (size_t i = 0; i < measured.size() && i < first_sights.size(); ++i)
-    {
-      const auto [cost, within] = matchCost(measured[i].normal, measured[i].d, truth, tolerance);
-      if (within && (nearest_measured < 0 || cost < nearest_measured_cost))
-      {
-        nearest_measured = static_cast<int>(i);
-        nearest_measured_cost = cost;
-      }
-    }
-    if (nearest_measured >= 0)
-      return std::string("seen, not yet in the map: ") + toString(first_sights[nearest_measured]);
-    return "seen, not yet in the map";
+    const FirstSight* first_sight = nearestFirstSight(detector, [&](const Eigen::Vector3d& n, double d) {
+      const MatchCost match = matchCost(n, d, truth, tolerance);
+      return match.within ? match.cost : -1.0;
+    });
+    return first_sight ? std::string("seen, not yet in the map: ") + toString(*first_sight) : "seen, not yet in the map";
   }
   return std::string(toString(best->verdict)) + (best->parallel_search ? " (parallel search)" : "");
 }
