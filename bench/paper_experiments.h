@@ -35,7 +35,8 @@ DetectorParams paramsFor(double noise, int resolution);
 
 // Why our detector missed a visible true plane in its last frame: the fate of the local peak
 // that matches it, or of the nearest candidate within three tolerances when none matches, or
-// no peak at all, or a per-frame plane the map has not reported yet.
+// no peak at all, or a per-frame plane the map has not reported yet; first, a random room's
+// shelf-board face that the sensor saw from behind (the generator's open board front).
 std::string missCause(const PlaneDetector& detector, const TruePlane& truth);
 
 // Table 3's three scenes, and the other camera paths they are also toured along.
