@@ -27,6 +27,19 @@ double surfaceReach(double offset_variance)
 {
   return 3.0 * std::sqrt(offset_variance + kSurfaceWarp * kSurfaceWarp);
 }
+// A snapped measurement's own normal as a tilt across `direction` (the normal it took), and
+// that tilt's information (1/rad^2), both in the plane across `direction`.
+struct SnapTilt
+{
+  Eigen::Vector3d tilt;
+  Eigen::Matrix3d information;
+};
+SnapTilt snapTilt(const FramePlane& measured, const Eigen::Vector3d& direction)
+{
+  const Eigen::Vector3d own = direction.dot(measured.own_normal) >= 0.0 ? measured.own_normal : -measured.own_normal;
+  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - direction * direction.transpose();
+  return {across * own, across * measured.own_normal_information * across};
+}
 }  // namespace
 
 PlaneMap::PlaneMap(const DetectorParams& params, const HoughParameterization& param, const HoughVoting& voting,
@@ -218,10 +231,7 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
       }
     }
     if (match < 0) continue;
-    const Eigen::Vector3d& normal = planes_[match].normal;
-    const Eigen::Vector3d own = normal.dot(measured.own_normal) >= 0.0 ? measured.own_normal : -measured.own_normal;
-    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - normal * normal.transpose();
-    const Eigen::Matrix3d information = across * measured.own_normal_information * across;
+    const SnapTilt own = snapTilt(measured, planes_[match].normal);
     SnapTilts& tilts = snap_tilts_[planes_[match].id];
     // A new viewpoint when the camera moved a block's width as seen from the face (8 of a
     // Kinect's 580 px): the depth errors fixed to pixels then fall elsewhere on it.
@@ -241,8 +251,8 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
     }
     if (tilts.last_frame != frame_count_) ++tilts.viewpoint_frames;
     tilts.last_frame = frame_count_;
-    tilts.viewpoint_information += information;
-    tilts.viewpoint_weighted_tilt += information * (across * own);
+    tilts.viewpoint_information += own.information;
+    tilts.viewpoint_weighted_tilt += own.information * own.tilt;
     tilts.centroid_sum += measured.centroid;
     ++tilts.measurements;
     updated[match] = 1;
@@ -491,8 +501,9 @@ double PlaneMap::sharedDirectionSigma(const FramePlane& snapped, const std::vect
   const double infinite = std::numeric_limits<double>::infinity();
   if (!snapped.parallel || snapped.own_normal.isZero()) return infinite;
   const Eigen::Vector3d& direction = snapped.normal;
+  const Eigen::Vector3d u = direction.unitOrthogonal();
   Eigen::Matrix<double, 3, 2> tangent;
-  tangent << direction.unitOrthogonal(), direction.cross(direction.unitOrthogonal());
+  tangent << u, direction.cross(u);
   Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
   Eigen::Vector2d weighted_tilt = Eigen::Vector2d::Zero();
   double chi2_each = 0.0;
@@ -504,9 +515,9 @@ double PlaneMap::sharedDirectionSigma(const FramePlane& snapped, const std::vect
       continue;
     if (std::any_of(planes_.begin(), planes_.end(), [&](const DetectedPlane& known) { return samePlane(known, other); }))
       continue;
-    const Eigen::Vector3d own = other.own_normal.dot(direction) >= 0.0 ? other.own_normal : -other.own_normal;
-    const Eigen::Vector2d tilt = tangent.transpose() * (own - direction);
-    const Eigen::Matrix2d own_information = tangent.transpose() * other.own_normal_information * tangent;
+    const SnapTilt own = snapTilt(other, direction);
+    const Eigen::Vector2d tilt = tangent.transpose() * own.tilt;
+    const Eigen::Matrix2d own_information = tangent.transpose() * own.information * tangent;
     information += own_information;
     weighted_tilt += own_information * tilt;
     chi2_each += tilt.dot(own_information * tilt);
