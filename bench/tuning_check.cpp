@@ -38,6 +38,7 @@ constexpr int kTableThreeFrames = 60;
 constexpr int kFigureSevenFrames = 48;
 constexpr int kFigureSevenStride = 4;
 double noise_correlation_px = 0.0;  // --noise-correlation: the renderer's correlated noise (KinectNoise)
+int room_frames = kRoomFrames;      // --room-frames: frames per room tour, a multiple of kRoomFrames
 
 struct SetResult
 {
@@ -81,9 +82,9 @@ std::string describeFalsePlane(const std::string& where, int frame, const PlaneD
 
 using ParamsFor = std::function<DetectorParams(double noise)>;
 
-// One camera path through one scene: scored from kWarmupFrames on every stride-th frame.
+// One camera path through one scene: scored from `warmup` on every stride-th frame.
 void runSequence(const std::string& where, const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, double noise,
-                 uint32_t noise_seed, int stride, const DetectorParams& params, SetResult& result)
+                 uint32_t noise_seed, int warmup, int stride, const DetectorParams& params, SetResult& result)
 {
   const SceneRenderer renderer(scene);
   PlaneDetector detector(params);
@@ -95,7 +96,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
   {
     const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
     detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
-    if (static_cast<int>(f) < kWarmupFrames || (static_cast<int>(f) - kWarmupFrames) % stride != 0) continue;
+    if (static_cast<int>(f) < warmup || (static_cast<int>(f) - warmup) % stride != 0) continue;
     const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
                                                evaluatedPlanes(detector.planes()));
     room.add(metrics);
@@ -122,11 +123,13 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
   SetResult result{name, {}, {}, {}, {}};
   for (uint32_t seed : seeds)
   {
-    RandomScene room = makeRandomScene(seed, kRoomFrames);
+    RandomScene room = makeRandomScene(seed, room_frames);
     if (noise_override > 0.0) room.noise = noise_override;
-    // The room's own noise seeds, as make evaluate renders them.
-    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000, 3,
-                params_for(room.noise), result);
+    // The room's own noise seeds, as make evaluate renders them; a denser tour of the same circle
+    // is scored at the same viewpoints.
+    const int denser = room_frames / kRoomFrames;
+    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000, kWarmupFrames * denser,
+                3 * denser, params_for(room.noise), result);
   }
   return result;
 }
@@ -135,7 +138,8 @@ SetResult runTableThree(const ParamsFor& params_for)
 {
   SetResult result{"Table 3's tours", {}, {}, {}, {}};
   for (const NamedScene& named : tableThreeScenes())
-    runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, 3, params_for(1.0), result);
+    runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, kWarmupFrames, 3,
+                params_for(1.0), result);
   return result;
 }
 
@@ -145,7 +149,8 @@ SetResult runOtherTours(const ParamsFor& params_for)
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
       runSequence(std::string(named.name) + ", " + tour.name, named.scene,
-                  roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, 3, params_for(1.0), result);
+                  roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, kWarmupFrames, 3, params_for(1.0),
+                  result);
   return result;
 }
 
@@ -155,8 +160,8 @@ SetResult runFigureSeven(const ParamsFor& params_for)
   SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}, {}};
   DetectorParams params = params_for(4.0);
   params.forgetting = kForgetByThinning;
-  runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kFigureSevenStride, params,
-              result);
+  runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kWarmupFrames,
+              kFigureSevenStride, params, result);
   return result;
 }
 
@@ -243,6 +248,9 @@ int main(int argc, char** argv)
       ("noise-correlation", po::value(&noise_correlation_px)->value_name("PX"),
        "render spatially correlated noise, a field smoothed over PX pixels (real frames' structure; default 0: "
        "independent per pixel, as make evaluate renders)")
+      ("room-frames", po::value(&room_frames)->value_name("N"),
+       "tour each procedural room in N frames (a multiple of 30; default 30, as make evaluate) along the same circle, "
+       "scored at the same viewpoints: a denser stream, as a camera at a higher frame rate sends")
       ("list", "every false plane of a scored frame (with the true plane nearest it) and every missed one (with its cause)")
       ("per-room", po::value(&per_room_path)->value_name("FILE"),
        "write each room's (camera path's) counts to FILE, for a later run's --against")
@@ -263,6 +271,11 @@ int main(int argc, char** argv)
   {
     std::cout << "usage: tuning_check [options]\n" << options << detector_options;
     return 0;
+  }
+  if (room_frames < kRoomFrames || room_frames % kRoomFrames != 0)
+  {
+    std::cerr << "tuning_check: --room-frames must be a multiple of " << kRoomFrames << ", got " << room_frames << "\n";
+    return 2;
   }
   std::vector<std::pair<std::string, std::string>> overrides;
   for (const auto& value : values)

@@ -127,8 +127,8 @@ TEST(MapFile, RefusesBrokenOrForeignFilesAndKeepsTheCurrentMap)
   EXPECT_EQ(target.planes().size(), source.planes().size());
 }
 
-// Forgetting by evidence: each plane's belief (log-odds, confirmations, contradictions) is part
-// of the map (format version 2), so a restored map goes on exactly; a version-1 file (no
+// Forgetting by evidence: each plane's belief (log-odds, confirmations, contradictions; since
+// version 4 its one-surface measurements) is part of the map (format version 2), so a restored map goes on exactly; a version-1 file (no
 // beliefs) still loads, its planes unconfirmed, and a version-2 file (no snapped tilts) too.
 TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
 {
@@ -139,6 +139,9 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
   int64_t confirmations = 0;
   for (const DetectedPlane& p : original.planes()) confirmations += p.confirmations;
   ASSERT_GT(confirmations, 0) << "eight frames of the office confirmed its planes";
+  int64_t one_surface = 0;
+  for (const DetectedPlane& p : original.planes()) one_surface += original.map().belief(p.id)->one_surface_measurements;
+  ASSERT_GT(one_surface, 0) << "and measured them as one surface each";
   PlaneDetector restored(evidence);
   std::string error;
   ASSERT_TRUE(restored.deserializeMap(original.serializeMap(), &error)) << error;
@@ -153,6 +156,11 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
     {
       EXPECT_EQ(restored.planes()[i].confirmations, original.planes()[i].confirmations);
       EXPECT_EQ(restored.planes()[i].contradictions, original.planes()[i].contradictions);
+      const PlaneBelief* kept = original.map().belief(original.planes()[i].id);
+      const PlaneBelief* loaded = restored.map().belief(restored.planes()[i].id);
+      ASSERT_TRUE(kept && loaded);
+      EXPECT_EQ(loaded->log_odds, kept->log_odds);
+      EXPECT_EQ(loaded->one_surface_measurements, kept->one_surface_measurements);
     }
   }
 

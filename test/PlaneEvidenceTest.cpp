@@ -178,3 +178,71 @@ TEST(PlaneEvidence, ATakenAwayBoxLeavesWithinThirtyFrames)
     }
   }
 }
+
+// Depths within 3 sigma + 2 cm of a plane confirm it, so they confirm a plane fitted through two
+// surfaces (a box's side and the face of the box stacked on it) as readily as one surface, in
+// every frame that sees them from about the same view. The map keeps a plane out of view only
+// once a frame measured it as one surface (FramePlane::measuresOneSurface): here a wall's map
+// plane, confirmed by its depths for ten frames, each frame's measurement of it a region that
+// fits its blocks or one that does not; then the camera looks away for thirty frames.
+TEST(PlaneEvidence, OnlyAPlaneMeasuredAsOneSurfaceIsKeptOutOfView)
+{
+  Scene scene;
+  scene.addRectangle({2.0, 0, 1.0}, kY, kZ, 1.5, 1.0, "wall");
+  const Eigen::Isometry3d pose = lookAt({0, 0, 1.0}, {2.0, 0, 1.0});
+  const RenderedFrame seen = SceneRenderer(scene).render(pose, kinect(1.0), 7);
+  const PinholeIntrinsics intrinsics = estimateIntrinsics(seen.view());
+  ASSERT_TRUE(intrinsics.valid());
+  const DepthNoiseModel noise(kKinectV1, 1.0, intrinsics.fx);
+  // The wall's blocks as the labels would hand them to the map: one per 5 cm extent cell.
+  FrameData observed;
+  observed.camera_to_world = pose;
+  for (double y = -1.4; y <= 1.4; y += 0.05)
+    for (double z = 0.1; z <= 1.9; z += 0.05)
+    {
+      BlockInfo block;
+      block.centroid = pose.inverse() * Eigen::Vector3d(2.0, y, z);
+      observed.blocks.push_back(block);
+    }
+  for (bool one_surface : {true, false})
+  {
+    DetectorParams params;
+    ASSERT_EQ(params.forgetting, kForgetByEvidence);
+    const HoughParameterization param{params.effectiveAngleStep(), params.effectiveDStep(), params.max_distance,
+                                      params.blur_kernel_size / 2 + params.peak_window / 2 + 2};
+    const HoughVoting voting{param, params.blur_kernel_size / 2, params.blur_sigma};
+    const HoughPeakSearch search{param, params.peak_window / 2};
+    PlaneMap map{params, param, voting, search};
+    FramePlane wall;
+    wall.normal = -kX;
+    wall.d = 2.0;
+    wall.hough = param.toHough(wall.normal, wall.d);
+    wall.support = wall.first_sight_points = 20000;
+    wall.blocks = {1, 2, 3};
+    wall.fits_its_blocks = one_surface;
+    wall.normal_sigma = 0.002;
+    wall.offset_sigma = 0.001;
+    wall.centroid = Eigen::Vector3d(2.0, 0, 1.0);
+    int f = 0;
+    for (; f < 10; ++f)
+    {
+      map.beginFrame();
+      map.checkEvidence(seen.view(), pose, intrinsics, noise);
+      map.accumulate({wall}, pose.translation(), f);
+      ASSERT_EQ(map.planes().size(), 1u) << "frame " << f;
+      map.observe({20000}, std::vector<int>(observed.blocks.size(), map.planes()[0].id), observed, f);
+    }
+    const PlaneBelief* belief = map.belief(map.planes()[0].id);
+    ASSERT_NE(belief, nullptr);
+    EXPECT_GE(belief->confirmations, PlaneBelief::kEstablishedAfter) << "its depths confirmed it";
+    EXPECT_EQ(belief->established(), one_surface);
+    // Looking away: no evidence and no measurement.
+    for (; f < 40; ++f)
+    {
+      map.beginFrame();
+      map.accumulate({}, pose.translation(), f);
+      map.observe(std::vector<int>(map.planes().size(), 0), std::vector<int>(observed.blocks.size(), -1), observed, f);
+    }
+    EXPECT_EQ(map.planes().size(), one_surface ? 1u : 0u) << (one_surface ? "measured as one surface" : "never measured as one surface");
+  }
+}

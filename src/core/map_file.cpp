@@ -15,8 +15,9 @@ namespace hough_plane_detector
 namespace
 {
 constexpr char kMagic[8] = {'H', 'P', 'D', 'M', 'A', 'P', '\n', '\0'};
-// 2: plane beliefs (forgetting by evidence) after the extents; 3: the snapped tilts after them.
-constexpr uint32_t kVersion = 3;
+// 2: plane beliefs (forgetting by evidence) after the extents; 3: the snapped tilts after them;
+// 4: each belief's one-surface measurements.
+constexpr uint32_t kVersion = 4;
 constexpr uint32_t kOldestReadVersion = 1;  // 1: no beliefs; its planes load unconfirmed
 
 // A map's keys in order: a map file does not depend on hash order.
@@ -144,6 +145,7 @@ std::string PlaneMap::serialize() const
     w.put(belief.log_odds);
     w.put(belief.confirmations);
     w.put(belief.contradictions);
+    w.put(belief.one_surface_measurements);
   }
   const std::vector<int> tilt_ids = sortedIds(snap_tilts_);
   w.put(static_cast<uint32_t>(tilt_ids.size()));
@@ -231,17 +233,22 @@ std::string readExtents(Reader& r, std::unordered_map<int, PlaneExtent>& extents
   return "";
 }
 
-std::string readBeliefs(Reader& r, std::unordered_map<int, PlaneBelief>& beliefs)
+std::string readBeliefs(Reader& r, uint32_t version, std::unordered_map<int, PlaneBelief>& beliefs)
 {
   uint32_t belief_count;
-  constexpr size_t kBeliefBytes = 4 + 8 + 8 + 8;
-  if (!r.get(belief_count) || belief_count > r.remaining() / kBeliefBytes) return "map beliefs are truncated";
+  const size_t belief_bytes = version >= 4 ? 4 + 8 + 8 + 8 + 8 : 4 + 8 + 8 + 8;
+  if (!r.get(belief_count) || belief_count > r.remaining() / belief_bytes) return "map beliefs are truncated";
   for (uint32_t i = 0; i < belief_count; ++i)
   {
     int32_t id;
     PlaneBelief belief;
     if (!r.get(id) || !r.get(belief.log_odds) || !r.get(belief.confirmations) || !r.get(belief.contradictions))
       return "map beliefs are truncated";
+    // An older map kept its planes by depth confirmations alone: they keep that standing.
+    belief.one_surface_measurements = 1;
+    if (version >= 4 && !r.get(belief.one_surface_measurements)) return "map beliefs are truncated";
+    if (belief.confirmations < 0 || belief.contradictions < 0 || belief.one_surface_measurements < 0)
+      return "map beliefs have a negative count";
     beliefs[id] = belief;
   }
   return "";
@@ -320,7 +327,7 @@ bool PlaneMap::deserialize(const std::string& bytes, std::string* error)
   std::string problem = readPlanes(r, planes);
   if (problem.empty()) problem = readChunks(r, global_.topLevelCount(), chunks);
   if (problem.empty()) problem = readExtents(r, extents);
-  if (problem.empty() && version >= 2) problem = readBeliefs(r, beliefs);
+  if (problem.empty() && version >= 2) problem = readBeliefs(r, version, beliefs);
   if (problem.empty() && version >= 3) problem = readSnapTilts(r, snap_tilts);
   if (!problem.empty()) return fail(problem);
   if (r.position() != bytes.size() - sizeof(uint64_t)) return fail("map has trailing bytes");

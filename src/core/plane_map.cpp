@@ -113,7 +113,11 @@ int PlaneMap::accumulate(const std::vector<FramePlane>& frame_planes, const Eige
                         params_.merge_angle, params_.merge_distance, param_,
                         [&](const HoughPeak& a, const HoughPeak& b) { return measuredApart(a, b, frame_planes); });
   matchIds(peaks, camera_position, stamp);
-  if (params_.forgetting == kForgetByEvidence) carryBeliefs();
+  if (params_.forgetting == kForgetByEvidence)
+  {
+    carryBeliefs();
+    countOneSurfaceMeasurements(frame_planes);
+  }
   reseatRefutedSnaps(frame_planes, camera_position);
   return evicted;
 }
@@ -663,6 +667,15 @@ void PlaneMap::carryBeliefs()
     plane.contradictions = belief.contradictions;
   }
   beliefs_.swap(beliefs);
+}
+
+void PlaneMap::countOneSurfaceMeasurements(const std::vector<FramePlane>& frame_planes)
+{
+  for (const DetectedPlane& plane : planes_)
+    if (std::any_of(frame_planes.begin(), frame_planes.end(), [&](const FramePlane& measured) {
+          return measured.measuresOneSurface() && samePlane(plane, measured);
+        }))
+      ++beliefs_[plane.id].one_surface_measurements;
 }
 
 void PlaneMap::observe(const std::vector<int>& support, const std::vector<int>& block_labels, const FrameData& frame,

@@ -73,6 +73,11 @@ struct FramePlane
   // the known normal explains them (PlaneMap::reseatRefutedSnaps); zero otherwise.
   Eigen::Vector3d own_normal = Eigen::Vector3d::Zero();
   Eigen::Matrix3d own_normal_information = Eigen::Matrix3d::Zero();
+
+  // A measurement of one surface: a region that fits its blocks, or a plane measured without
+  // blocks (the parallel search's, tested cluster by cluster; the paper's windows). The map keeps
+  // a plane out of view only once such a measurement has supported it (PlaneBelief).
+  bool measuresOneSurface() const { return fits_its_blocks || blocks.empty(); }
 };
 
 class FramePlaneFitter

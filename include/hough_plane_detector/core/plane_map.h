@@ -73,6 +73,12 @@ public:
   // Forgetting by evidence: each plane's belief from this frame's depths over its extent.
   void checkEvidence(const CloudView& cloud, const Eigen::Isometry3d& camera_to_world,
                      const PinholeIntrinsics& intrinsics, const DepthNoiseModel& noise);
+  // A map plane's belief (forgetting by evidence); null for an id without one.
+  const PlaneBelief* belief(int id) const
+  {
+    const auto it = beliefs_.find(id);
+    return it == beliefs_.end() ? nullptr : &it->second;
+  }
   // Alg. 2: thins the space, adds one Gaussian per frame plane (up to 2 for a strong plane not
   // yet in the map), caps the chunks, and makes the space's peaks the map's planes, each
   // keeping the id of the previous plane it continues. Returns the chunks the cap evicted.
@@ -157,6 +163,8 @@ private:
   void matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp);
   // Beliefs follow the ids: new planes start afresh, planes that left the map take theirs along.
   void carryBeliefs();
+  // Each map plane that one of this frame's measurements of one surface supports (PlaneBelief).
+  void countOneSurfaceMeasurements(const std::vector<FramePlane>& frame_planes);
   // How fast extents fade per frame: with thinning as the Hough space does, by evidence never.
   float extentFade() const;
   // A snapped measurement took a known normal its blocks may only nearly fit (a box front 2 deg
