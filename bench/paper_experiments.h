@@ -155,6 +155,8 @@ struct RandomSceneExperiment
   // The later held-out lists (kSecondHeldOutSeeds, kThirdHeldOutSeeds), the defaults only, at
   // each room's C and at C = 1.
   MethodStats second_held_out, second_held_out_at_c1, third_held_out, third_held_out_at_c1;
+  // All three lists at C = 1 toured in twice the frames, scored at the same viewpoints (reported).
+  MethodStats held_out_at_c1_denser;
   size_t held_out_seeds = 0, second_held_out_seeds = 0, third_held_out_seeds = 0, tuning_seeds = 0;
   std::vector<HeldOutRoom> rooms;              // the held-out seeds one by one
   // The defaults' counts in each room of all three held-out lists, at its own C and at C = 1:
