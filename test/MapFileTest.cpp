@@ -28,6 +28,13 @@ void warmUp(PlaneDetector& detector, int frames)
   }
 }
 
+// A map file's body (without its checksum) as version `version`, with its checksum anew.
+std::string withVersion(std::string body, uint32_t version)
+{
+  std::memcpy(&body[8], &version, sizeof(version));  // the version follows the 8-byte magic
+  return PlaneDetector::withMapChecksum(body);
+}
+
 void writeFile(const std::string& path, const std::string& bytes)
 {
   std::ofstream(path, std::ios::binary) << bytes;
@@ -175,17 +182,6 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
   // The snapped tilts close the file: a count, then that many records.
   ASSERT_GT(thinning.map().snapTiltRecords(), 0u) << "the office's later frames snap to its known planes";
   const size_t tilt_section = sizeof(uint32_t) + thinning.map().snapTiltRecords() * kTiltBytes;
-  auto withVersion = [](std::string body, uint32_t version) {
-    std::memcpy(&body[8], &version, sizeof(version));
-    uint64_t hash = 1469598103934665603ull;
-    for (char c : body)
-    {
-      hash ^= static_cast<unsigned char>(c);
-      hash *= 1099511628211ull;
-    }
-    body.append(reinterpret_cast<const char*>(&hash), sizeof(hash));
-    return body;
-  };
   bytes.resize(bytes.size() - tilt_section);
   PlaneDetector version_two_reader(evidence);
   ASSERT_TRUE(version_two_reader.deserializeMap(withVersion(bytes, 2), &error)) << error;
@@ -196,6 +192,44 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
   ASSERT_TRUE(old_reader.deserializeMap(bytes, &error)) << error;
   expectSameMap(thinning, old_reader);
   for (const DetectedPlane& p : old_reader.planes()) EXPECT_EQ(p.confirmations, 0);
+}
+
+// A version-3 file holds each belief without its one-surface measurements (version 4): its
+// planes keep the standing they had, every belief counted as measured as one surface once.
+TEST(MapFile, VersionThreeBeliefsLoadAsMeasuredOnce)
+{
+  DetectorParams evidence;
+  evidence.forgetting = kForgetByEvidence;
+  PlaneDetector original(evidence);
+  warmUp(original, 8);
+  std::string body = original.serializeMap();
+  body.resize(body.size() - sizeof(uint64_t));  // the checksum
+  // The beliefs (a count, then id, log-odds, confirmations, contradictions and one-surface
+  // measurements each) come just before the snapped tilts, which close the file.
+  constexpr size_t kBeliefBytes = 4 + 4 * 8;
+  const size_t tilts = sizeof(uint32_t) + original.map().snapTiltRecords() * kTiltBytes;
+  const size_t beliefs = original.planes().size();
+  const size_t section = body.size() - tilts - sizeof(uint32_t) - beliefs * kBeliefBytes;
+  uint32_t count;
+  std::memcpy(&count, &body[section], sizeof(count));
+  ASSERT_EQ(count, beliefs) << "one belief per plane";
+  std::string old = body.substr(0, section + sizeof(uint32_t));
+  for (size_t i = 0; i < beliefs; ++i)
+    old += body.substr(section + sizeof(uint32_t) + i * kBeliefBytes, kBeliefBytes - 8);
+  old += body.substr(body.size() - tilts);
+  PlaneDetector restored(evidence);
+  std::string error;
+  ASSERT_TRUE(restored.deserializeMap(withVersion(old, 3), &error)) << error;
+  expectSameMap(original, restored);
+  for (const DetectedPlane& plane : original.planes())
+  {
+    const PlaneBelief* kept = original.map().belief(plane.id);
+    const PlaneBelief* loaded = restored.map().belief(plane.id);
+    ASSERT_TRUE(kept && loaded);
+    EXPECT_EQ(loaded->log_odds, kept->log_odds);
+    EXPECT_EQ(loaded->confirmations, kept->confirmations);
+    EXPECT_EQ(loaded->one_surface_measurements, 1);
+  }
 }
 
 // Found by fuzz_map_file: a count far beyond the file's size made the loader allocate for it
