@@ -599,10 +599,11 @@ bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured)
                                params_.merge_distance);
 }
 
-bool PlaneMap::remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const
+bool PlaneMap::remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes,
+                          bool as_one_surface) const
 {
   for (const FramePlane& measured : frame_planes)
-    if (samePlane(plane, measured)) return true;
+    if ((!as_one_surface || measured.measuresOneSurface()) && samePlane(plane, measured)) return true;
   return false;
 }
 
@@ -672,10 +673,7 @@ void PlaneMap::carryBeliefs()
 void PlaneMap::countOneSurfaceMeasurements(const std::vector<FramePlane>& frame_planes)
 {
   for (const DetectedPlane& plane : planes_)
-    if (std::any_of(frame_planes.begin(), frame_planes.end(), [&](const FramePlane& measured) {
-          return measured.measuresOneSurface() && samePlane(plane, measured);
-        }))
-      ++beliefs_[plane.id].one_surface_measurements;
+    if (remeasured(plane, frame_planes, true)) ++beliefs_[plane.id].one_surface_measurements;
 }
 
 void PlaneMap::observe(const std::vector<int>& support, const std::vector<int>& block_labels, const FrameData& frame,

@@ -142,8 +142,10 @@ private:
   void clearPeakCells(const Eigen::Vector3d& hough);
   // Calls f on every cell of the peak window and blur around `hough` (and its mirrored copy).
   void forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const;
-  // True when one of this frame's planes lies on `plane` within the merge tolerances.
-  bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
+  // True when one of this frame's planes (those that measure one surface, if asked) lies on
+  // `plane` within the merge tolerances.
+  bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes,
+                  bool as_one_surface = false) const;
   // Two surfaces closer than a peak window share one maximum: when this frame measured them
   // apart, or the map held them apart and depths confirmed them, the maximum's peak moves to
   // one of them and each other gets a peak at its own place (this frame's, else the map's).
