@@ -395,11 +395,12 @@ RandomSceneExperiment runRandomScenes(bool quick)
     std::vector<MethodStats> stats(used);
     KinectNoise noise;
     noise.coefficient = room.noise;
+    const RoomTourScoring scoring(denser);
     for (int f = 0; f < frames * denser; ++f)
     {
       const RenderedFrame frame = renderer.render(room.poses[f], noise, seed * 1000 + f);
       for (auto& detector : detectors) detector->processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
-      if (f < kWarmupFrames * denser || (f - kWarmupFrames * denser) % (3 * denser) != 0) continue;
+      if (!scoring.scored(f)) continue;
       for (size_t v = 0; v < used; ++v)
         stats[v].add(evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
                                    evaluatedPlanes(detectors[v]->planes())));

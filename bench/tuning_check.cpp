@@ -125,11 +125,10 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
   {
     RandomScene room = makeRandomScene(seed, room_frames);
     if (noise_override > 0.0) room.noise = noise_override;
-    // The room's own noise seeds, as make evaluate renders them; a denser tour of the same circle
-    // is scored at the same viewpoints.
-    const int denser = room_frames / kRoomFrames;
-    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000, kWarmupFrames * denser,
-                3 * denser, params_for(room.noise), result);
+    // The room's own noise seeds and scored frames, as make evaluate renders and scores them.
+    const RoomTourScoring scoring(room_frames / kRoomFrames);
+    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000, scoring.warmup,
+                scoring.stride, params_for(room.noise), result);
   }
   return result;
 }
