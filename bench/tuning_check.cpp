@@ -7,9 +7,11 @@
 // With --osd, the annotated real frames of osd-learn too (one frame each, PCL left out).
 // Each set's line is followed by its 95 % interval over its rooms; --per-room FILE keeps each
 // room's counts, and a later run's --against FILE prints each set's effect paired by room.
-// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--list] [--noise-correlation PX]
-//        [--per-room FILE] [--against FILE] [--PARAM VALUE ...]
+// Usage: tuning_check [--sets LIST] [--osd DIR] [--causes] [--list] [--sigma-calibration]
+//        [--noise-correlation PX] [--room-frames N] [--per-room FILE] [--against FILE] [--PARAM VALUE ...]
 // (see --help)
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -47,7 +49,27 @@ struct SetResult
   std::vector<RoomCounts> rooms;  // one per camera path, for the intervals over rooms
   std::map<std::string, int> causes;  // our misses by cause
   std::vector<std::string> listed;  // one line per false or missed plane of a scored frame
+  std::vector<double> sigma_ratios;  // each new fitting region's normal error over its normal_sigma
 };
+
+// A new surface's own fit (not snapped, fitting its blocks, no map plane's re-measurement): its
+// normal's angle to the true plane its centroid lies on (within 3 cm), over its normal_sigma.
+void addSigmaRatios(const PlaneDetector& detector, const std::vector<TruePlane>& truth, std::vector<double>& ratios)
+{
+  constexpr double kOnPlane = 0.03, kNearAngle = 0.15;
+  const std::vector<FramePlane>& planes = detector.lastFramePlanes();
+  const std::vector<FirstSight>& first_sights = detector.map().lastFirstSights();
+  for (size_t i = 0; i < planes.size() && i < first_sights.size(); ++i)
+  {
+    const FramePlane& p = planes[i];
+    if (p.parallel || !p.fits_its_blocks || !(p.normal_sigma > 0.0) || first_sights[i] == FirstSight::kKnownPlane)
+      continue;
+    double angle = kNearAngle;
+    for (const TruePlane& t : truth)
+      if (std::abs(t.normal.dot(p.centroid) + t.d) < kOnPlane) angle = std::min(angle, angleError(p.normal, t.normal));
+    if (angle < kNearAngle) ratios.push_back(angle / p.normal_sigma);
+  }
+}
 
 // A false plane: where, what, and the true plane nearest it (hidden ones too).
 std::string describeFalsePlane(const std::string& where, int frame, const PlaneDetector& detector,
@@ -96,6 +118,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
   {
     const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
     detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
+    addSigmaRatios(detector, renderer.truePlanes(), result.sigma_ratios);  // every frame: first sights happen in any
     if (static_cast<int>(f) < warmup || (static_cast<int>(f) - warmup) % stride != 0) continue;
     const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
                                                evaluatedPlanes(detector.planes()));
@@ -120,7 +143,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
 SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const ParamsFor& params_for,
                    double noise_override = 0.0)
 {
-  SetResult result{name, {}, {}, {}, {}};
+  SetResult result{name, {}, {}, {}, {}, {}};
   for (uint32_t seed : seeds)
   {
     RandomScene room = makeRandomScene(seed, room_frames);
@@ -135,7 +158,7 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
 
 SetResult runTableThree(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's tours", {}, {}, {}, {}};
+  SetResult result{"Table 3's tours", {}, {}, {}, {}, {}};
   for (const NamedScene& named : tableThreeScenes())
     runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, kWarmupFrames, 3,
                 params_for(1.0), result);
@@ -144,7 +167,7 @@ SetResult runTableThree(const ParamsFor& params_for)
 
 SetResult runOtherTours(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's scenes, other tours", {}, {}, {}, {}};
+  SetResult result{"Table 3's scenes, other tours", {}, {}, {}, {}, {}};
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
       runSequence(std::string(named.name) + ", " + tour.name, named.scene,
@@ -156,7 +179,7 @@ SetResult runOtherTours(const ParamsFor& params_for)
 SetResult runFigureSeven(const ParamsFor& params_for)
 {
   // As make evaluate runs Fig. 7: the paper's thinning, the office at C = 4, resolution 1024.
-  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}, {}};
+  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}, {}, {}};
   DetectorParams params = params_for(4.0);
   params.forgetting = kForgetByThinning;
   runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kWarmupFrames,
@@ -200,7 +223,22 @@ void writeRooms(std::ostream& out, const SetResult& r)
         << ' ' << room.frames << '\n';
 }
 
-void print(const SetResult& r, bool causes, bool list, const RoomsBySet& earlier)
+// How far new surfaces' own fits lie off their truth, in their normal_sigma: the first-sight
+// report trusts that sigma. Were it exact in both tilt directions, the ratio would follow a
+// Rayleigh distribution: median 1.18, above 2 in 13.5 %, above 2 sqrt(2) in 1.8 %.
+void printSigmaCalibration(std::vector<double> ratios)
+{
+  if (ratios.empty()) return;
+  std::sort(ratios.begin(), ratios.end());
+  const double n = static_cast<double>(ratios.size());
+  auto above = [&](double x) { return 100.0 * static_cast<double>(ratios.end() - std::upper_bound(ratios.begin(), ratios.end(), x)) / n; };
+  std::printf("    new fitting regions' normal error / normal_sigma (%zu fits): median %.2f, q95 %.2f, above 2: %.1f %%, "
+              "above 2 sqrt(2): %.1f %% (Rayleigh: 1.18, 2.45, 13.5 %%, 1.8 %%)\n",
+              ratios.size(), ratios[ratios.size() / 2], ratios[static_cast<size_t>(0.95 * (n - 1))], above(2.0),
+              above(2.0 * M_SQRT2));
+}
+
+void print(const SetResult& r, bool causes, bool list, bool sigma_calibration, const RoomsBySet& earlier)
 {
   std::printf("%-32s %5.1f %% (%d/%d)  false/frame %.3f  E_angle %.4f  E_d %.4f  frames %d\n", r.name.c_str(),
               r.stats.detectionPercent(), r.stats.detected, r.stats.visible, r.stats.falsePerFrame(), mean(r.stats.angle),
@@ -222,6 +260,7 @@ void print(const SetResult& r, bool causes, bool list, const RoomsBySet& earlier
                 effect.found_percent.high, effect.false_per_frame.value, effect.false_per_frame.low,
                 effect.false_per_frame.high);
   }
+  if (sigma_calibration) printSigmaCalibration(r.sigma_ratios);
   if (list)
     for (const std::string& line : r.listed) std::printf("    %s\n", line.c_str());
   if (!causes) return;
@@ -244,6 +283,7 @@ int main(int argc, char** argv)
        "table3, other, fig7 (default: all but development-c-c1)")
       ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
       ("causes", "our misses of each set by what became of their candidate")
+      ("sigma-calibration", "how far new surfaces' own fits lie off their true planes, in their normal_sigma")
       ("noise-correlation", po::value(&noise_correlation_px)->value_name("PX"),
        "render spatially correlated noise, a field smoothed over PX pixels (real frames' structure; default 0: "
        "independent per pixel, as make evaluate renders)")
@@ -346,7 +386,7 @@ int main(int argc, char** argv)
   for (auto& future : results)
   {
     const SetResult result = future.get();
-    print(result, causes, list_planes, earlier);
+    print(result, causes, list_planes, values.count("sigma-calibration") > 0, earlier);
     if (per_room.is_open()) writeRooms(per_room, result);
   }
   if (osd_dir.empty()) return 0;
