@@ -41,6 +41,7 @@ constexpr int kFigureSevenFrames = 48;
 constexpr int kFigureSevenStride = 4;
 double noise_correlation_px = 0.0;  // --noise-correlation: the renderer's correlated noise (KinectNoise)
 int room_frames = kRoomFrames;      // --room-frames: frames per room tour, a multiple of kRoomFrames
+bool sigma_calibration = false;     // --sigma-calibration: collect and print SetResult::sigma_ratios
 
 struct SetResult
 {
@@ -118,7 +119,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
   {
     const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
     detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
-    addSigmaRatios(detector, renderer.truePlanes(), result.sigma_ratios);  // every frame: first sights happen in any
+    if (sigma_calibration) addSigmaRatios(detector, renderer.truePlanes(), result.sigma_ratios);  // first sights: any frame
     if (static_cast<int>(f) < warmup || (static_cast<int>(f) - warmup) % stride != 0) continue;
     const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
                                                evaluatedPlanes(detector.planes()));
@@ -238,7 +239,7 @@ void printSigmaCalibration(std::vector<double> ratios)
               above(2.0 * M_SQRT2));
 }
 
-void print(const SetResult& r, bool causes, bool list, bool sigma_calibration, const RoomsBySet& earlier)
+void print(const SetResult& r, bool causes, bool list, const RoomsBySet& earlier)
 {
   std::printf("%-32s %5.1f %% (%d/%d)  false/frame %.3f  E_angle %.4f  E_d %.4f  frames %d\n", r.name.c_str(),
               r.stats.detectionPercent(), r.stats.detected, r.stats.visible, r.stats.falsePerFrame(), mean(r.stats.angle),
@@ -311,6 +312,7 @@ int main(int argc, char** argv)
     std::cout << "usage: tuning_check [options]\n" << options << detector_options;
     return 0;
   }
+  sigma_calibration = values.count("sigma-calibration") > 0;
   if (room_frames < kRoomFrames || room_frames % kRoomFrames != 0)
   {
     std::cerr << "tuning_check: --room-frames must be a multiple of " << kRoomFrames << ", got " << room_frames << "\n";
@@ -386,7 +388,7 @@ int main(int argc, char** argv)
   for (auto& future : results)
   {
     const SetResult result = future.get();
-    print(result, causes, list_planes, values.count("sigma-calibration") > 0, earlier);
+    print(result, causes, list_planes, earlier);
     if (per_room.is_open()) writeRooms(per_room, result);
   }
   if (osd_dir.empty()) return 0;
