@@ -394,7 +394,7 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
            accuracyRow(e.variants.front(), e.third_held_out_at_c1);
   table += fmt("| **all %zu held-out** ", all_held_out) + accuracyRow(e.variants.front(), pooled);
   table += fmt("| **all %zu held-out, at C = 1** ", all_held_out) + accuracyRow(e.variants.front(), pooled_at_c1);
-  table += fmt("| all %zu held-out, at C = 1, %d-frame tours ", all_held_out, 2 * e.frames) +
+  table += fmt("| all %zu held-out, at C = 1, %d-frame tours ", all_held_out, kDenserTourFactor * e.frames) +
            accuracyRow(e.variants.front(), e.held_out_at_c1_denser);
   for (size_t v = 0; v < e.variants.size(); ++v)
     table += fmt("| %zu tuning ", e.tuning_seeds) + accuracyRow(e.variants[v], e.tuning[v]);
@@ -423,7 +423,7 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
                    "the same circles in twice the frames, scored at the same viewpoints: the stream of a faster camera, "
                    "in which a view repeats before the next differs. Targets on the held-out seeds: "
                    ">= 95 %% detected, <= 0.05 false planes per frame, E_angle <= 0.01 rad, E_d <= 1 cm.\n\n",
-                   e.frames, kWarmupFrames, 2 * e.frames)
+                   e.frames, kWarmupFrames, kDenserTourFactor * e.frames)
             << table << "\n| held-out seed | room | defaults detected | false / frame | windows detected | "
                         "false / frame |\n|---|---|---|---|---|---|\n"
             << rows << '\n';

@@ -395,7 +395,7 @@ RandomSceneExperiment runRandomScenes(bool quick)
     std::vector<MethodStats> stats(used);
     KinectNoise noise;
     noise.coefficient = room.noise;
-    const RoomTourScoring scoring(denser);
+    const TourScoring scoring = roomTourScoring(denser);
     for (int f = 0; f < frames * denser; ++f)
     {
       const RenderedFrame frame = renderer.render(room.poses[f], noise, seed * 1000 + f);
@@ -439,13 +439,14 @@ RandomSceneExperiment runRandomScenes(bool quick)
           result.second_held_out_at_c1);
   runList("third", kThirdHeldOutSeeds, result.third_held_out_seeds, result.third_held_out,
           result.third_held_out_at_c1);
-  // The three lists at C = 1 again, toured in twice the frames: the stream of a faster camera.
+  // The three lists at C = 1 again, toured in kDenserTourFactor times the frames: the stream of a
+  // faster camera.
   std::vector<MethodStats> denser(1);
   auto runDenser = [&](const std::vector<uint32_t>& seeds, size_t count) {
     for (size_t i = 0; i < count; ++i)
     {
-      std::fprintf(stderr, "  held-out seed %u, %d frames\n", seeds[i], 2 * frames);
-      runSeed(seeds[i], denser, false, 1.0, true, nullptr, 2);
+      std::fprintf(stderr, "  held-out seed %u, %d frames\n", seeds[i], kDenserTourFactor * frames);
+      runSeed(seeds[i], denser, false, 1.0, true, nullptr, kDenserTourFactor);
     }
   };
   runDenser(kHeldOutSeeds, result.held_out_seeds);

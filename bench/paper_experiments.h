@@ -24,14 +24,16 @@ namespace hough_plane_detector
 
 constexpr int kMinVisiblePoints = 2000;  // planes smaller in a frame are neither expected nor counted
 constexpr int kWarmupFrames = 3;         // our map needs global_threshold frames before it reports
-// Which frames of a procedural room's tour are scored: from the warm-up on, every third; a tour
-// of the same circle in `denser` times the frames is scored at the same viewpoints.
-struct RoomTourScoring
+// Which frames of a tour are scored: from `warmup` on, every stride-th.
+struct TourScoring
 {
   int warmup, stride;
-  explicit RoomTourScoring(int denser = 1) : warmup(kWarmupFrames * denser), stride(3 * denser) {}
   bool scored(int frame) const { return frame >= warmup && (frame - warmup) % stride == 0; }
 };
+// A procedural room's tour: every third frame after the warm-up; a tour of the same circle in
+// `denser` times the frames is scored at the same viewpoints.
+inline TourScoring roomTourScoring(int denser = 1) { return {kWarmupFrames * denser, 3 * denser}; }
+constexpr int kDenserTourFactor = 2;  // make evaluate's reported row of denser held-out tours
 constexpr int kResolutionCount = 3;
 extern const int kResolutions[kResolutionCount];  // Fig. 7's Hough resolutions
 

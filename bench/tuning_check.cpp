@@ -105,9 +105,9 @@ std::string describeFalsePlane(const std::string& where, int frame, const PlaneD
 
 using ParamsFor = std::function<DetectorParams(double noise)>;
 
-// One camera path through one scene: scored from `warmup` on every stride-th frame.
+// One camera path through one scene, scored at `scoring`'s frames.
 void runSequence(const std::string& where, const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, double noise,
-                 uint32_t noise_seed, int warmup, int stride, const DetectorParams& params, SetResult& result)
+                 uint32_t noise_seed, const TourScoring& scoring, const DetectorParams& params, SetResult& result)
 {
   const SceneRenderer renderer(scene);
   PlaneDetector detector(params);
@@ -120,7 +120,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
     const RenderedFrame frame = renderer.render(poses[f], kinect, noise_seed + static_cast<uint32_t>(f));
     detector.processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
     if (sigma_calibration) addSigmaRatios(detector, renderer.truePlanes(), result.sigma_ratios);  // first sights: any frame
-    if (static_cast<int>(f) < warmup || (static_cast<int>(f) - warmup) % stride != 0) continue;
+    if (!scoring.scored(static_cast<int>(f))) continue;
     const FrameMetrics metrics = evaluateFrame(renderer.truePlanes(), frame.visible_points, kMinVisiblePoints,
                                                evaluatedPlanes(detector.planes()));
     room.add(metrics);
@@ -150,9 +150,8 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
     RandomScene room = makeRandomScene(seed, room_frames);
     if (noise_override > 0.0) room.noise = noise_override;
     // The room's own noise seeds and scored frames, as make evaluate renders and scores them.
-    const RoomTourScoring scoring(room_frames / kRoomFrames);
-    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000, scoring.warmup,
-                scoring.stride, params_for(room.noise), result);
+    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000,
+                roomTourScoring(room_frames / kRoomFrames), params_for(room.noise), result);
   }
   return result;
 }
@@ -161,8 +160,8 @@ SetResult runTableThree(const ParamsFor& params_for)
 {
   SetResult result{"Table 3's tours", {}, {}, {}, {}, {}};
   for (const NamedScene& named : tableThreeScenes())
-    runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed, kWarmupFrames, 3,
-                params_for(1.0), result);
+    runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed,
+                TourScoring{kWarmupFrames, 3}, params_for(1.0), result);
   return result;
 }
 
@@ -172,8 +171,8 @@ SetResult runOtherTours(const ParamsFor& params_for)
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
       runSequence(std::string(named.name) + ", " + tour.name, named.scene,
-                  roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, kWarmupFrames, 3, params_for(1.0),
-                  result);
+                  roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, TourScoring{kWarmupFrames, 3},
+                  params_for(1.0), result);
   return result;
 }
 
@@ -183,8 +182,8 @@ SetResult runFigureSeven(const ParamsFor& params_for)
   SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}, {}, {}};
   DetectorParams params = params_for(4.0);
   params.forgetting = kForgetByThinning;
-  runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed, kWarmupFrames,
-              kFigureSevenStride, params, result);
+  runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed,
+              TourScoring{kWarmupFrames, kFigureSevenStride}, params, result);
   return result;
 }
 
