@@ -92,7 +92,10 @@ TEST(FramePlaneFitter, ASnapPrefersTheKnownPlaneThePieceLiesOn)
 // model cannot tell the two normals apart (rendered faces scatter well below it), the
 // patch's own scatter can. With the world's up known, a face off the vertical keeps its own
 // normal (boxes at any yaw are parallel only by chance); a floor patch still takes a known
-// normal as far off, since level surfaces are parallel by gravity; with up unknown both snap.
+// normal as far off, since level surfaces are parallel by gravity. With up unknown no normal
+// is known to be level: both keep their own normal against another surface's (the known
+// plane 0.5 m off the patch) and both take the known normal of a plane they lie on (their
+// own surface re-measured).
 TEST(FramePlaneFitter, AFaceOffTheVerticalSnapsOnlyIfItsOwnScatterCannotTellTheNormals)
 {
   Frame f;
@@ -121,21 +124,28 @@ TEST(FramePlaneFitter, AFaceOffTheVerticalSnapsOnlyIfItsOwnScatterCannotTellTheN
     const TruePlane& truth = f.renderer.truePlanes()[f.truePlane(c.plane)];
     const std::vector<int> blocks = patch(c.plane, c.k);
     ASSERT_GT(blocks.size(), 40u) << c.plane;
+    PointMoments points;
+    for (int b : blocks) points.add(f.frame.moments(b));
+    const Eigen::Vector3d centroid = f.frame.camera_to_world * points.mean();
     DetectedPlane known;
     known.normal = Eigen::AngleAxisd(c.turn, c.axis) * truth.normal;
-    known.d = truth.d;
     const PlanarityTests::NormalExplanation explained =
         f.tests.explainNormal(f.frame.normalInCamera(known.normal), blocks, false);
     ASSERT_TRUE(explained.interior) << c.plane << ": the noise model must not tell the normals, or this shows nothing";
     ASSERT_FALSE(explained.interior_within_own_scatter) << c.plane << ": its own scatter must tell them";
-    for (int up_known = 0; up_known <= 1; ++up_known)
+    for (double off_the_patch : {0.0, 0.5})
     {
-      f.params.world_z_up = up_known;
-      FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
-      Eigen::Vector3d normal = truth.normal;
-      double d = truth.d;
-      EXPECT_EQ(fitter.snapToKnownDirection(normal, d, blocks, {known}, {}), !up_known || c.snaps_with_up_known)
-          << c.plane << ", world_z_up " << up_known;
+      known.d = -known.normal.dot(centroid) + off_the_patch;
+      for (int up_known = 0; up_known <= 1; ++up_known)
+      {
+        f.params.world_z_up = up_known;
+        FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
+        Eigen::Vector3d normal = truth.normal;
+        double d = truth.d;
+        const bool snaps = up_known ? c.snaps_with_up_known : off_the_patch == 0.0;
+        EXPECT_EQ(fitter.snapToKnownDirection(normal, d, blocks, {known}, {}), snaps)
+            << c.plane << ", world_z_up " << up_known << ", known plane " << off_the_patch << " m off the patch";
+      }
     }
   }
 }

@@ -577,7 +577,8 @@ bool FramePlaneFitter::normalDetermined(double normal_sigma) const
 
 const Eigen::Vector3d* FramePlaneFitter::knownNormalFor(const Eigen::Vector3d& normal, const Eigen::Vector3d& centroid,
                                                        const std::vector<DetectedPlane>& map_planes,
-                                                       const std::vector<FramePlane>& planes) const
+                                                       const std::vector<FramePlane>& planes,
+                                                       bool* on_that_plane) const
 {
   // A piece of a known plane is most likely that surface re-measured: its direction comes
   // before a parallel plane's elsewhere that happens to be closer to the piece's noisy fit
@@ -600,6 +601,7 @@ const Eigen::Vector3d* FramePlaneFitter::knownNormalFor(const Eigen::Vector3d& n
   };
   for (const DetectedPlane& plane : map_planes) consider(plane.normal, plane.d);
   for (const FramePlane& plane : planes) consider(plane.normal, plane.d);
+  if (on_that_plane) *on_that_plane = closest_on != nullptr;
   return closest_on ? closest_on : closest;
 }
 
@@ -615,8 +617,9 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   if (blocks.empty()) return false;
   PointMoments piece;
   for (int b : blocks) piece.add(frame_.moments(b));
+  bool on_known_plane = false;
   const Eigen::Vector3d* known_normal =
-      knownNormalFor(normal, frame_.camera_to_world * piece.mean(), map_planes, planes);
+      knownNormalFor(normal, frame_.camera_to_world * piece.mean(), map_planes, planes, &on_known_plane);
   if (!known_normal) return false;
   const Eigen::Vector3d known = known_normal->dot(normal) >= 0.0 ? *known_normal : Eigen::Vector3d(-*known_normal);
   const Eigen::Vector3d n_cam = frame_.normalInCamera(known);
@@ -657,6 +660,11 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   // one face's: a grown region's. The windows' blocks are all within support_distance of the
   // peak's plane (a cabinet front and a desk's edge 3 cm before it): their scatter is the mix.
   if (!tests_.acceptsKnownNormal(explained, known)) return false;
+  // Without the world's up no direction is known to be level, so the direction of another
+  // surface (the piece off its plane) may be parallel only by chance (box faces at any yaw):
+  // it too must hold against a grown region's own scatter. Its own surface re-measured need not.
+  if (!params_.world_z_up && params_.region_growing && !on_known_plane && !explained.interior_within_own_scatter)
+    return false;
   // Near the sensor the rim blocks are oriented too; if with them the known normal no longer
   // explains the face, its own normal is the better model, when the points determine it.
   if (!explained.with_oriented_rim && normalDetermined(tests_.normalUncertainty(inliers))) return false;

@@ -104,8 +104,10 @@ public:
                                   std::vector<int>& blocks, bool tight = false);
   // Gives an accepted plane within snap_angle of a known plane (the map's, or this frame's in
   // `planes`) that normal, and the offset its blocks agree on, when most of its points lie
-  // on that parallel plane within their noise and the likelihood-ratio test allows. True if it
-  // did; then `measured_by`, when given, holds the blocks on that plane that measured its offset.
+  // on that parallel plane within their noise and the likelihood-ratio test allows (and, with
+  // the world's up unknown and another surface's normal, the region's own scatter: see
+  // PlanarityTests::acceptsKnownNormal). True if it did; then `measured_by`, when given, holds
+  // the blocks on that plane that measured its offset.
   bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
                             const std::vector<DetectedPlane>& map_planes, const std::vector<FramePlane>& planes,
                             std::vector<int>* measured_by = nullptr) const;
@@ -147,9 +149,10 @@ private:
   // The normal of a known plane (the map's, or this frame's) within snap_angle of `normal`: of
   // the closest in angle that passes within merge_distance of `centroid` (world frame), the
   // piece's, if any, else of the closest; nullptr when none is within snap_angle.
+  // `on_that_plane`, when given: whether the normal is of a plane the piece lies on.
   const Eigen::Vector3d* knownNormalFor(const Eigen::Vector3d& normal, const Eigen::Vector3d& centroid,
                                         const std::vector<DetectedPlane>& map_planes,
-                                        const std::vector<FramePlane>& planes) const;
+                                        const std::vector<FramePlane>& planes, bool* on_that_plane = nullptr) const;
 
   const DetectorParams& params_;
   const HoughParameterization& param_;
