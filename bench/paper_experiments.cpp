@@ -151,10 +151,10 @@ std::vector<RenderedFrame> renderSequence(const SceneRenderer& renderer, const s
   return frames;
 }
 
-// Our map through a tour of one scene at C = 1.0, scored on every stride-th frame from
-// kWarmupFrames; PCL's methods on exactly those frames when with_pcl. Misses of ours are
-// tallied by cause into `causes`.
-TourResult runTour(const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, uint32_t seed, int stride,
+// Our map through a tour of one scene at C = 1.0, scored on the frames `scoring` names; PCL's
+// methods on exactly those frames when with_pcl. Misses of ours are tallied by cause into
+// `causes`.
+TourResult runTour(const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, uint32_t seed, TourScoring scoring,
                    bool with_pcl, std::map<std::string, int>& causes, int region_growing = DetectorParams().region_growing,
                    int forgetting = DetectorParams().forgetting)
 {
@@ -171,7 +171,7 @@ TourResult runTour(const Scene& scene, const std::vector<Eigen::Isometry3d>& pos
   {
     detector.processFrame(rendered[f].view(), rendered[f].camera_to_world, 0.1 * f);
     result.ours.ms.push_back(detector.lastTimings().total_ms);
-    if (static_cast<int>(f) < kWarmupFrames || (static_cast<int>(f) - kWarmupFrames) % stride != 0) continue;
+    if (!scoring.scored(static_cast<int>(f))) continue;
     const FrameMetrics metrics =
         evaluateFrame(truth, rendered[f].visible_points, kMinVisiblePoints, evaluatedPlanes(detector.planes()));
     result.ours.add(metrics);
@@ -200,6 +200,7 @@ NoiseExperiment runNoiseExperiment(bool quick)
   const int frames = result.frames;
   SceneRenderer renderer(makeOfficeRoom());
   const auto poses = roomTour(frames);
+  const TourScoring scoring{kWarmupFrames, result.stride};
   result.memory_mb.assign(frames, {});
   for (double noise : kNoiseLevels)
   {
@@ -224,13 +225,14 @@ NoiseExperiment runNoiseExperiment(bool quick)
           level.final_chunks = mem.global_chunks;
           level.final_dense_share = static_cast<double>(mem.global_bytes) / mem.dense_bytes;
         }
-        if (f >= kWarmupFrames && (f - kWarmupFrames) % result.stride == 0)
+        if (scoring.scored(f))
           level.ours[r].add(evaluateFrame(renderer.truePlanes(), rendered[f].visible_points, kMinVisiblePoints,
                                           evaluatedPlanes(detector.planes())));
       }
     }
-    for (int f = kWarmupFrames; f < frames; f += result.stride)
+    for (int f = 0; f < frames; ++f)
     {
+      if (!scoring.scored(f)) continue;
       std::fprintf(stderr, "    PCL methods on frame %d\n", f);
       runComparators(rendered[f], renderer.truePlanes(), result.ransac_iterations, ransacThreshold(noise),
                      kMinVisiblePoints, level.ransac, level.organized);
@@ -299,7 +301,8 @@ RoomExperiment runRoomTours(bool quick)
   {
     std::fprintf(stderr, "  Table 3: %s\n", named.name);
     result.scenes.push_back(
-        {named.name, runTour(named.scene, roomTour(result.frames), kRoomTourSeed, result.stride, true, result.causes)});
+        {named.name, runTour(named.scene, roomTour(result.frames), kRoomTourSeed, TourScoring{kWarmupFrames, result.stride},
+                             true, result.causes)});
   }
   return result;
 }
@@ -308,7 +311,6 @@ OtherToursExperiment runOtherTours(bool quick)
 {
   const std::vector<TourPath> tours = otherTourPaths();
   const size_t tour_count = quick ? 1 : tours.size();
-  const int stride = 3;
   OtherToursExperiment result;
   result.with_pcl = !quick;
   for (size_t i = 0; i < tour_count; ++i)
@@ -320,7 +322,7 @@ OtherToursExperiment runOtherTours(bool quick)
     for (const auto& named : tableThreeScenes())
     {
       const TourResult scene_tour = runTour(named.scene, roomTour(tour.frames, tour.centre, tour.radius), tour.seed,
-                                            stride, result.with_pcl, result.causes);
+                                            roomTourScoring(), result.with_pcl, result.causes);
       row.ours.merge(scene_tour.ours);
       row.ransac.merge(scene_tour.ransac);
       row.organized.merge(scene_tour.organized);
@@ -333,7 +335,7 @@ OtherToursExperiment runOtherTours(bool quick)
 std::vector<StageRow> runStageAndForgettingTours(bool quick)
 {
   const int frames = quick ? 16 : 60;
-  const int stride = quick ? 8 : 3;
+  const TourScoring scoring{kWarmupFrames, quick ? 8 : 3};
   std::map<std::string, int> causes;
   std::vector<StageRow> rows;
   for (const auto& named : tableThreeScenes())
@@ -341,9 +343,9 @@ std::vector<StageRow> runStageAndForgettingTours(bool quick)
     std::fprintf(stderr, "  windows' fit: %s\n", named.name);
     StageRow row;
     row.scene = named.name;
-    row.windows = runTour(named.scene, roomTour(frames), kRoomTourSeed, stride, false, causes, 0).ours;
-    row.regions = runTour(named.scene, roomTour(frames), kRoomTourSeed, stride, false, causes, 1).ours;
-    row.thinning = runTour(named.scene, roomTour(frames), kRoomTourSeed, stride, false, causes, 1, kForgetByThinning).ours;
+    row.windows = runTour(named.scene, roomTour(frames), kRoomTourSeed, scoring, false, causes, 0).ours;
+    row.regions = runTour(named.scene, roomTour(frames), kRoomTourSeed, scoring, false, causes, 1).ours;
+    row.thinning = runTour(named.scene, roomTour(frames), kRoomTourSeed, scoring, false, causes, 1, kForgetByThinning).ours;
     rows.push_back(row);
   }
   return rows;
