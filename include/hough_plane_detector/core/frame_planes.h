@@ -105,9 +105,10 @@ public:
   // Gives an accepted plane within snap_angle of a known plane (the map's, or this frame's in
   // `planes`) that normal, and the offset its blocks agree on, when most of its points lie
   // on that parallel plane within their noise and the likelihood-ratio test allows (and, with
-  // the world's up unknown and another surface's normal, the region's own scatter: see
-  // PlanarityTests::acceptsKnownNormal). True if it did; then `measured_by`, when given, holds
-  // the blocks on that plane that measured its offset.
+  // the world's up unknown and another surface's normal, a grown region's own scatter too:
+  // NormalExplanation::interior_within_own_scatter, as acceptsKnownNormal asks with up known
+  // of normals off the vertical). True if it did; then `measured_by`, when given, holds the
+  // blocks on that plane that measured its offset.
   bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
                             const std::vector<DetectedPlane>& map_planes, const std::vector<FramePlane>& planes,
                             std::vector<int>* measured_by = nullptr) const;
