@@ -30,8 +30,8 @@ struct TourScoring
   int warmup, stride;
   bool scored(int frame) const { return frame >= warmup && (frame - warmup) % stride == 0; }
 };
-// A procedural room's tour: every third frame after the warm-up; a tour of the same circle in
-// `denser` times the frames is scored at the same viewpoints.
+// A room tour (Table 3's, its other paths, a procedural room's): every third frame after the
+// warm-up; a tour of the same circle in `denser` times the frames is scored at the same viewpoints.
 inline TourScoring roomTourScoring(int denser = 1) { return {kWarmupFrames * denser, 3 * denser}; }
 constexpr int kDenserTourFactor = 2;  // make evaluate's reported row of denser held-out tours
 constexpr int kResolutionCount = 3;

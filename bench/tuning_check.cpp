@@ -161,7 +161,7 @@ SetResult runTableThree(const ParamsFor& params_for)
   SetResult result{"Table 3's tours", {}, {}, {}, {}, {}};
   for (const NamedScene& named : tableThreeScenes())
     runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed,
-                TourScoring{kWarmupFrames, 3}, params_for(1.0), result);
+                roomTourScoring(), params_for(1.0), result);
   return result;
 }
 
@@ -171,7 +171,7 @@ SetResult runOtherTours(const ParamsFor& params_for)
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
       runSequence(std::string(named.name) + ", " + tour.name, named.scene,
-                  roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, TourScoring{kWarmupFrames, 3},
+                  roomTour(tour.frames, tour.centre, tour.radius), 1.0, tour.seed, roomTourScoring(),
                   params_for(1.0), result);
   return result;
 }
