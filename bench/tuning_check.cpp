@@ -20,6 +20,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hough_plane_detector/core/plane_detector.h"
@@ -45,6 +46,8 @@ bool sigma_calibration = false;     // --sigma-calibration: collect and print Se
 
 struct SetResult
 {
+  explicit SetResult(std::string set_name) : name(std::move(set_name)) {}
+
   std::string name;
   MethodStats stats;
   std::vector<RoomCounts> rooms;  // one per camera path, for the intervals over rooms
@@ -144,7 +147,7 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
 SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const ParamsFor& params_for,
                    double noise_override = 0.0)
 {
-  SetResult result{name, {}, {}, {}, {}, {}};
+  SetResult result(name);
   for (uint32_t seed : seeds)
   {
     RandomScene room = makeRandomScene(seed, room_frames);
@@ -158,7 +161,7 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
 
 SetResult runTableThree(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's tours", {}, {}, {}, {}, {}};
+  SetResult result("Table 3's tours");
   for (const NamedScene& named : tableThreeScenes())
     runSequence(std::string(named.name), named.scene, roomTour(kTableThreeFrames), 1.0, kRoomTourSeed,
                 roomTourScoring(), params_for(1.0), result);
@@ -167,7 +170,7 @@ SetResult runTableThree(const ParamsFor& params_for)
 
 SetResult runOtherTours(const ParamsFor& params_for)
 {
-  SetResult result{"Table 3's scenes, other tours", {}, {}, {}, {}, {}};
+  SetResult result("Table 3's scenes, other tours");
   for (const TourPath& tour : otherTourPaths())
     for (const NamedScene& named : tableThreeScenes())
       runSequence(std::string(named.name) + ", " + tour.name, named.scene,
@@ -179,7 +182,7 @@ SetResult runOtherTours(const ParamsFor& params_for)
 SetResult runFigureSeven(const ParamsFor& params_for)
 {
   // As make evaluate runs Fig. 7: the paper's thinning, the office at C = 4, resolution 1024.
-  SetResult result{"Fig. 7 office, C = 4, thinning", {}, {}, {}, {}, {}};
+  SetResult result("Fig. 7 office, C = 4, thinning");
   DetectorParams params = params_for(4.0);
   params.forgetting = kForgetByThinning;
   runSequence("office", makeOfficeRoom(), roomTour(kFigureSevenFrames), 4.0, kNoiseTourSeed,
