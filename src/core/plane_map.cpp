@@ -221,19 +221,7 @@ void PlaneMap::reseatRefutedSnaps(const std::vector<FramePlane>& frame_planes, c
   for (const FramePlane& measured : frame_planes)
   {
     if (measured.own_normal.isZero()) continue;
-    // The map plane it voted into: the closest within the merge tolerances.
-    int match = -1;
-    double best_cost = 0.0;
-    for (size_t p = 0; p < planes_.size(); ++p)
-    {
-      if (!samePlane(planes_[p], measured)) continue;
-      const double cost = mergeCost(measured, planes_[p]);
-      if (match < 0 || cost < best_cost)
-      {
-        match = static_cast<int>(p);
-        best_cost = cost;
-      }
-    }
+    const int match = remeasuredPlane(measured);
     if (match < 0) continue;
     const SnapTilt own = snapTilt(measured, planes_[match].normal);
     SnapTilts& tilts = snap_tilts_[planes_[match].id];
@@ -597,6 +585,23 @@ bool PlaneMap::samePlane(const DetectedPlane& known, const FramePlane& measured)
 {
   return withinMergeTolerances(known.normal, known.d, measured.normal, measured.d, params_.merge_angle,
                                params_.merge_distance);
+}
+
+int PlaneMap::remeasuredPlane(const FramePlane& measured) const
+{
+  int match = -1;
+  double best_cost = 0.0;
+  for (size_t p = 0; p < planes_.size(); ++p)
+  {
+    if (!samePlane(planes_[p], measured)) continue;
+    const double cost = mergeCost(measured, planes_[p]);
+    if (match < 0 || cost < best_cost)
+    {
+      match = static_cast<int>(p);
+      best_cost = cost;
+    }
+  }
+  return match;
 }
 
 bool PlaneMap::remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes,

@@ -142,6 +142,9 @@ private:
   void clearPeakCells(const Eigen::Vector3d& hough);
   // Calls f on every cell of the peak window and blur around `hough` (and its mirrored copy).
   void forPeakCells(const Eigen::Vector3d& hough, const std::function<void(int, int, int)>& f) const;
+  // The map plane (index of planes_) a frame's plane re-measures: the closest within the merge
+  // tolerances (samePlane), or -1 when none is.
+  int remeasuredPlane(const FramePlane& measured) const;
   // True when one of this frame's planes (those that measure one surface, if asked) lies on
   // `plane` within the merge tolerances.
   bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes,
