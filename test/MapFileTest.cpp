@@ -1,6 +1,5 @@
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -195,10 +194,9 @@ TEST(MapFile, BeliefsSurviveASaveAndLoadAndVersionOneFilesStillLoad)
   for (const DetectedPlane& p : old_reader.planes()) EXPECT_EQ(p.confirmations, 0);
 }
 
-// A version-3 file holds each belief without its one-surface measurements (version 4), and in a
-// version-4 file one of them kept a plane: their planes keep the standing they had, counted as
-// measured as one surface by as many frames as keep a plane now (version 5).
-TEST(MapFile, OlderBeliefsKeepTheStandingTheyHad)
+// A version-3 file holds each belief without its one-surface measurements (version 4): its
+// planes keep the standing they had, every belief counted as measured as one surface once.
+TEST(MapFile, VersionThreeBeliefsLoadAsMeasuredOnce)
 {
   DetectorParams evidence;
   evidence.forgetting = kForgetByEvidence;
@@ -230,25 +228,7 @@ TEST(MapFile, OlderBeliefsKeepTheStandingTheyHad)
     ASSERT_TRUE(kept && loaded);
     EXPECT_EQ(loaded->log_odds, kept->log_odds);
     EXPECT_EQ(loaded->confirmations, kept->confirmations);
-    EXPECT_EQ(loaded->one_surface_measurements, PlaneBelief::kOneSurfaceFramesToKeep);
-  }
-  // Version 4: the same bytes as now, but one measurement as one surface kept a plane then: a
-  // belief counting one (the first, set so here) rises to what keeps a plane now, others stay.
-  std::string four = body;
-  int32_t first_id;
-  std::memcpy(&first_id, &four[section + sizeof(uint32_t)], sizeof(first_id));
-  const int64_t once = 1;
-  std::memcpy(&four[section + sizeof(uint32_t) + kBeliefBytes - sizeof(once)], &once, sizeof(once));
-  PlaneDetector from_four(evidence);
-  ASSERT_TRUE(from_four.deserializeMap(withVersion(four, 4), &error)) << error;
-  expectSameMap(original, from_four);
-  for (const DetectedPlane& plane : original.planes())
-  {
-    const PlaneBelief* loaded = from_four.map().belief(plane.id);
-    ASSERT_TRUE(loaded);
-    EXPECT_EQ(loaded->one_surface_measurements, plane.id == first_id
-                                                    ? PlaneBelief::kOneSurfaceFramesToKeep
-                                                    : original.map().belief(plane.id)->one_surface_measurements);
+    EXPECT_EQ(loaded->one_surface_measurements, 1);
   }
 }
 

@@ -384,10 +384,10 @@ TEST(PlaneMap, ATentativePlaneFadesOnlyInFramesThatDoNotMeasureItAgain)
   EXPECT_NEAR(matching(m.map.planes(), kFloor)[0]->strength, remeasured - PlaneBelief::kTentativeFade, 0.1);
 }
 
-// A region that fits its blocks is reported from one frame only when it is precise enough to
-// lie within the merge tolerances of its surface at 2 sigma: its normal, and its offset at its
-// own points. How far the points lie from the world origin (the lever arm of a tilt error
-// there) does not matter.
+// A region that fits its blocks is reported from one frame only when it is precise enough that
+// a second measurement would agree with it: its normal, and its offset at its own points, within
+// the merge tolerances at 2 sigma of the difference of two measurements. How far the points lie
+// from the world origin (the lever arm of a tilt error there) does not matter.
 TEST(PlaneMap, AFittingRegionIsReportedAtFirstSightOnlyWhenPrecise)
 {
   struct Case
@@ -396,12 +396,10 @@ TEST(PlaneMap, AFittingRegionIsReportedAtFirstSightOnlyWhenPrecise)
     Eigen::Vector3d centroid;
     bool reported;
   };
-  // merge_angle 0.05, merge_distance 0.03: at 2 sigma, sigma_n <= 0.025 and the offset's sigma
-  // <= 0.015 m (at 2 sqrt(2) sigma, 0.02 and 0.012 would be refused). A wall x = 2 (normal x):
-  // the lever is the centroid's (y, z).
-  for (const Case& c : {Case{0.002, 0.001, {2.0, 0.0, 1.0}, true}, Case{0.02, 0.001, {2.0, 0.0, 1.0}, true},
-                        Case{0.03, 0.001, {2.0, 0.0, 1.0}, false}, Case{0.002, 0.012, {2.0, 0.0, 1.0}, true},
-                        Case{0.002, 0.016, {2.0, 0.0, 1.0}, false}, Case{0.002, 0.001, {2.0, 6.0, 1.0}, true}})
+  // merge_angle 0.05, merge_distance 0.03: at 2 sqrt(2) sigma, sigma_n <= 0.0177 and the
+  // offset's sigma <= 0.0106 m. A wall x = 2 (normal x): the lever is the centroid's (y, z).
+  for (const Case& c : {Case{0.002, 0.001, {2.0, 0.0, 1.0}, true}, Case{0.02, 0.001, {2.0, 0.0, 1.0}, false},
+                        Case{0.002, 0.012, {2.0, 0.0, 1.0}, false}, Case{0.002, 0.001, {2.0, 6.0, 1.0}, true}})
   {
     Map m;
     FramePlane wall = m.plane(Eigen::Vector3d(1, 0, 0), -2.0, 3000);  // 3,000 points: 1.19 by its points
@@ -445,7 +443,7 @@ TEST(PlaneMap, EachFramePlaneSaysHowItVotedAtFirstSight)
   parallel_search.parallel = true;
   parallel_search.first_sight_points = 1000;
   const std::vector<FramePlane> planes{wall, mixing, small, face(1.0, true, 0.002), face(1.5, false, 0.002),
-                                       face(-1.0, true, 0.03), near_wall, parallel_search};
+                                       face(-1.0, true, 0.02), near_wall, parallel_search};
   m.frame(planes, 0.1);
   const std::vector<FirstSight> expected{FirstSight::kKnownPlane,     FirstSight::kMixesSurfaces,
                                          FirstSight::kTooSmall,       FirstSight::kComplete,
@@ -463,15 +461,15 @@ TEST(PlaneMap, EachFramePlaneSaysHowItVotedAtFirstSight)
 }
 
 // Snapped new faces that took one known direction in one frame (a staircase's risers) measure
-// it together: three risers each too imprecise alone (sigma 0.03 rad) are reported at first
+// it together: three risers each too imprecise alone (sigma 0.022 rad) are reported at first
 // sight when their own normals agree with it and with each other, not one alone, not one whose
 // only companion is a map plane measured again, not two whose own normals lie apart beyond
 // their noise, and not four whose pooled normal refutes the known one.
 TEST(PlaneMap, SnappedFacesSharingADirectionMeasureItTogether)
 {
   const Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
-  const double sigma = 0.03;
-  auto riser = [&](const Map& m, double x, double tilt, double own_sigma = 0.03) {
+  const double sigma = 0.022;
+  auto riser = [&](const Map& m, double x, double tilt, double own_sigma = 0.022) {
     FramePlane p = m.fitting(direction, Eigen::Vector3d(x, 0.0, 0.5), 3000, own_sigma);
     p.parallel = true;
     p.first_sight_points = 1000;  // by support alone 1.25, under global_threshold
@@ -504,17 +502,17 @@ TEST(PlaneMap, SnappedFacesSharingADirectionMeasureItTogether)
               (std::vector<FirstSight>{FirstSight::kKnownPlane, FirstSight::kImprecise}));
   }
   {
-    Map m;  // each 2.3 sigmas off the known normal, 3.3 sigmas of their difference apart
-    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.07), riser(m, 1.3, -0.07)}, 0.0),
+    Map m;  // each 2.3 sigmas off the known normal, 3.2 sigmas of their difference apart
+    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.05), riser(m, 1.3, -0.05)}, 0.0),
               std::vector<FirstSight>(2, FirstSight::kImprecise));
   }
   {
-    Map m;  // each 1.7 sigmas off, together 3.3 of their pooled sigma
-    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.05), riser(m, 1.3, 0.05), riser(m, 1.6, 0.05), riser(m, 1.9, 0.05)},
+    Map m;  // each 1.6 sigmas off, together 3.2 of their pooled sigma
+    EXPECT_EQ(firstSights(m, {riser(m, 1.0, 0.035), riser(m, 1.3, 0.035), riser(m, 1.6, 0.035), riser(m, 1.9, 0.035)},
                           0.0),
               std::vector<FirstSight>(4, FirstSight::kImprecise));
   }
-  EXPECT_GT(2.0 * sigma, DetectorParams().merge_angle);  // imprecise alone
+  EXPECT_GT(2.0 * M_SQRT2 * sigma, DetectorParams().merge_angle);  // imprecise alone
 }
 
 // A precise new face near a known plane waits for a second frame only when it could be that

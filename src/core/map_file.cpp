@@ -16,9 +16,8 @@ namespace
 {
 constexpr char kMagic[8] = {'H', 'P', 'D', 'M', 'A', 'P', '\n', '\0'};
 // 2: plane beliefs (forgetting by evidence) after the extents; 3: the snapped tilts after them;
-// 4: each belief's one-surface measurements; 5: the same bytes, a plane kept out of view after
-// PlaneBelief::kOneSurfaceFramesToKeep of them instead of one.
-constexpr uint32_t kVersion = 5;
+// 4: each belief's one-surface measurements.
+constexpr uint32_t kVersion = 4;
 constexpr uint32_t kOldestReadVersion = 1;  // 1: no beliefs; its planes load unconfirmed
 
 // A map's keys in order: a map file does not depend on hash order.
@@ -245,12 +244,9 @@ std::string readBeliefs(Reader& r, uint32_t version, std::unordered_map<int, Pla
     PlaneBelief belief;
     if (!r.get(id) || !r.get(belief.log_odds) || !r.get(belief.confirmations) || !r.get(belief.contradictions))
       return "map beliefs are truncated";
-    // A version-3 map kept its planes by depth confirmations alone, and a version-4 map those
-    // measured as one surface once: they keep that standing.
-    belief.one_surface_measurements = PlaneBelief::kOneSurfaceFramesToKeep;
+    // An older map kept its planes by depth confirmations alone: they keep that standing.
+    belief.one_surface_measurements = 1;
     if (version >= 4 && !r.get(belief.one_surface_measurements)) return "map beliefs are truncated";
-    if (version == 4 && belief.one_surface_measurements > 0)
-      belief.one_surface_measurements = std::max(belief.one_surface_measurements, PlaneBelief::kOneSurfaceFramesToKeep);
     if (belief.confirmations < 0 || belief.contradictions < 0 || belief.one_surface_measurements < 0)
       return "map beliefs have a negative count";
     beliefs[id] = belief;

@@ -460,10 +460,9 @@ const char* toString(FirstSight first_sight)
 
 namespace
 {
-// A first measurement lies within the merge tolerances of its surface at 2 sigma (95 %); one
-// farther off stays tentative until a second frame measures it as one surface (PlaneBelief), so
-// it fades.
-constexpr double kFirstSightSigmas = 2.0;
+// Two measurements of one surface differ by sqrt(2) sigma; a tolerance holds at 2 sigma of that
+// difference.
+constexpr double kFirstSightSigmas = 2.0 * M_SQRT2;
 }  // namespace
 
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const

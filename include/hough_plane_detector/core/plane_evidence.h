@@ -52,31 +52,18 @@ struct PlaneBelief
   double log_odds = kStart;
   int64_t confirmations = 0;    // frames that confirmed it
   int64_t contradictions = 0;   // frames that contradicted it
-  // Frames that must measure a plane as one surface before it is kept out of view (and before
-  // it stops fading as tentative): two, so that a second measurement tells the surface from one
-  // frame's error (a face first fitted a few hundredths of a radian off).
-  static constexpr int64_t kOneSurfaceFramesToKeep = 2;
-
   // Frames that measured it as one surface (FramePlane::measuresOneSurface). Depths within
   // 3 sigma + 2 cm confirm a plane fitted through two surfaces too (a box's side and the face of
-  // the box stacked on it), or a face fitted 0.04 rad off, in every frame that sees them from
-  // about the same view; only measurements whose blocks lie on the plane within their noise tell
-  // one surface from such a mix.
+  // the box stacked on it), in every frame that sees them from about the same view; only a
+  // measurement whose blocks lie on the plane within their noise tells one surface from such a mix.
   int64_t one_surface_measurements = 0;
 
   // Applies one frame's evidence; true when it changed the belief.
   bool update(const PlaneEvidence& evidence);
   bool gone() const { return log_odds < kRemoveBelow; }
-  bool established() const
-  {
-    return confirmations >= kEstablishedAfter && one_surface_measurements >= kOneSurfaceFramesToKeep;
-  }
-  // Seen in one frame only (no later frame has confirmed it), or not yet measured as one surface
-  // by kOneSurfaceFramesToKeep frames.
-  bool tentative() const
-  {
-    return (confirmations == 0 || one_surface_measurements < kOneSurfaceFramesToKeep) && !gone();
-  }
+  bool established() const { return confirmations >= kEstablishedAfter && one_surface_measurements > 0; }
+  // Seen in one frame only (no later frame has confirmed it), or never measured as one surface.
+  bool tentative() const { return (confirmations == 0 || one_surface_measurements == 0) && !gone(); }
 };
 
 }  // namespace hough_plane_detector

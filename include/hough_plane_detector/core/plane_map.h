@@ -124,8 +124,8 @@ private:
   // and is not reported at first sight. Map planes flagged in `dropped` (this frame superseded
   // them) do not count: the measurement is what replaced them.
   bool nearKnownPlane(const FramePlane& measured, const std::vector<char>& dropped) const;
-  // True when the frame's plane is precise enough to lie within the merge tolerances of its
-  // surface at 2 sigma: its normal, and its offset at its own points.
+  // True when the frame's plane is precise enough that a second measurement of it falls within
+  // the merge tolerances of it: its normal, and its offset at its own points.
   bool preciseAtFirstSight(const FramePlane& measured) const;
   // The same, with a snapped plane's normal judged by every new surface of the frame that took
   // the same known direction (sharedDirectionSigma): a staircase's risers, a shelf's boards.
