@@ -16,6 +16,7 @@ namespace hough_plane_detector
 namespace
 {
 constexpr double kMinSnapInlierShare = 0.8;  // snapping: points that must lie on the parallel plane
+constexpr double kEdgeOnOffsetFloor = 0.001;  // m: an edge-on block's offset is never judged finer than this
 }  // namespace
 
 const char* toString(CandidateVerdict verdict)
@@ -192,8 +193,16 @@ void FramePlaneFitter::growRegions(const std::vector<HoughPeak>& peaks, const st
     Eigen::Vector3d normal = frame_.normalInWorld(region.normal);
     double d = frame_.dInWorld(normal, region.d);
     std::vector<int> snap_blocks;
-    const bool snapped = verdict == CandidateVerdict::kAccepted &&
-                         snapToKnownDirection(normal, d, region.blocks, map_planes, planes, &snap_blocks);
+    // A face seen edge-on cannot orient itself, but a known normal leaves only its offset to
+    // measure, and along grazing rays the depth error hardly moves a point off the plane. With
+    // the world's up known, gravity shares level and upright directions between surfaces (a
+    // table top seen from just above it and the floor), so such a face that passes the snap's
+    // tests is the known direction at its own offset.
+    const bool edge_on_with_up = verdict == CandidateVerdict::kEdgeOn && params_.world_z_up;
+    const bool snapped = (verdict == CandidateVerdict::kAccepted || edge_on_with_up) &&
+                         snapToKnownDirection(normal, d, region.blocks, map_planes, planes, &snap_blocks,
+                                              edge_on_with_up);
+    if (edge_on_with_up && snapped) verdict = CandidateVerdict::kAccepted;
     // Computed once: the orientation test and the accepted plane's record both need it.
     double normal_sigma = verdict == CandidateVerdict::kAccepted ? tests_.normalUncertainty(region.blocks) : 0.0;
     bool upright = false;
@@ -608,7 +617,7 @@ const Eigen::Vector3d* FramePlaneFitter::knownNormalFor(const Eigen::Vector3d& n
 bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
                                             const std::vector<DetectedPlane>& map_planes,
                                             const std::vector<FramePlane>& planes,
-                                            std::vector<int>* measured_by) const
+                                            std::vector<int>* measured_by, bool seen_edge_on) const
 {
   // A small or far plane nearly parallel to a known one (a stair tread to the floor, a shelf
   // top) is fitted with a tilt of a few degrees: blocks of the surfaces it meets lean on its
@@ -639,8 +648,17 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   for (int b : blocks)
   {
     const BlockInfo& info = frame_.blocks[b];
+    // A plane through (or near) the sensor images as a line, its horizon: the points of any
+    // surface in a block across that line lie near it, but scatter along the normal by the
+    // block's footprint, not by their depth noise as a face's points do.
+    if (seen_edge_on && !tests_.isThinAlong(b, n_cam)) continue;
     const double offset = -n_cam.dot(info.centroid);
-    if (std::abs(offset - median) > 3.0 * std::sqrt(tests_.centroidVariance(b))) continue;
+    // Along a grazing ray only the sine's share of the depth error lies along the normal: a
+    // block of the surface behind an edge-on face is far off its plane in that noise.
+    const double sine = std::abs(n_cam.dot(info.ray));
+    const double variance = seen_edge_on ? tests_.centroidVariance(b) * sine * sine + kEdgeOnOffsetFloor * kEdgeOnOffsetFloor
+                                         : tests_.centroidVariance(b);
+    if (std::abs(offset - median) > 3.0 * std::sqrt(variance)) continue;
     inliers.push_back(b);
     inlier_points += points(b);
     weight_sum += info.fit_weight;

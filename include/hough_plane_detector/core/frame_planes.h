@@ -108,10 +108,11 @@ public:
   // the world's up unknown and another surface's normal, a grown region's own scatter too:
   // NormalExplanation::interior_within_own_scatter, as acceptsKnownNormal asks with up known
   // of normals off the vertical). True if it did; then `measured_by`, when given, holds the
-  // blocks on that plane that measured its offset.
+  // blocks on that plane that measured its offset. A region `seen_edge_on` is judged by the
+  // share of its blocks' depth noise along the known normal (the ray's sine of it).
   bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
                             const std::vector<DetectedPlane>& map_planes, const std::vector<FramePlane>& planes,
-                            std::vector<int>* measured_by = nullptr) const;
+                            std::vector<int>* measured_by = nullptr, bool seen_edge_on = false) const;
 
 private:
   // The paper's refinement: up to three passes of taking the unclaimed windows near the
