@@ -9,6 +9,7 @@
 #include <boost/math/distributions/fisher_f.hpp>
 
 #include "hough_plane_detector/core/plane_geometry.h"
+#include "hough_plane_detector/core/planarity_tests.h"
 #include "hough_plane_detector/core/symmetric_eigen.h"
 
 namespace hough_plane_detector
@@ -123,6 +124,22 @@ void describeBlockRow(const NormalEstimator& grid, const DetectorParams& params,
   }
 }
 
+bool blockThinAlong(const BlockInfo& info, double points, const Eigen::Vector3d& n_cam)
+{
+  const double thickness = n_cam.dot(info.covariance * n_cam);
+  if (!(info.random_depth_variance > 0.0) || points < 2.0) return thickness <= info.thickness_limit;
+  // A depth error moves a point along its ray: by ray / ray.z per metre of depth.
+  const double along_normal = n_cam.dot(info.ray) / info.ray.z();
+  // The random part's sample variance (points - 1 degrees of freedom; the covariance divides
+  // by the count) within its p = 0.01 bound; quantization errors lie within half a step, so
+  // their variance is at most a quarter step squared (points split over two levels).
+  const double random = info.random_depth_variance * noiseBoundOfMeanChi2(static_cast<size_t>(points - 1.0)) *
+                        (points - 1.0) / points;
+  const double bound = (random + 0.25 * info.quantization_step * info.quantization_step) * along_normal * along_normal +
+                       kFaceRoughness * kFaceRoughness;
+  return thickness <= std::min(bound, info.thickness_limit);
+}
+
 BlockRegionGrower::BlockRegionGrower(const NormalEstimator& grid, const std::vector<BlockInfo>& info,
                                      const DetectorParams& params)
   : grid_(grid), info_(info), params_(params)
@@ -141,8 +158,11 @@ bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double
   if (oriented_only && i.normal_tolerance >= M_PI / 2) return false;
   if (std::abs(i.normal.dot(normal)) < i.normal_tolerance_cosine) return false;
   // Rays that graze a plane move along it with their depth error, so any surface they hit
-  // lies "on" it: a plane seen edge-on cannot be tested, and no block joins it that way.
-  return !(std::abs(normal.dot(i.ray)) < kMinRaySine);
+  // lies "on" it by its centroid; but a block whose points are thin along the normal, within
+  // the sine's share of their depth noise, lies on it point by point (a table top seen from
+  // just above it). Without a noise model no such share is known, and no grazing block joins.
+  return !(std::abs(normal.dot(i.ray)) < kMinRaySine) ||
+         (i.random_depth_variance > 0.0 && blockThinAlong(i, grid_.block(block).count, normal));
 }
 
 size_t BlockRegionGrower::sweep(std::vector<int>& blocks, const std::vector<char>& taken, const Eigen::Vector3d& normal,
@@ -178,9 +198,13 @@ bool BlockRegionGrower::wholeFacePlane(const PlaneRegion& region, const std::vec
 
 bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
 {
-  size_t grazing = 0;
-  for (int b : blocks) grazing += std::abs(normal.dot(info_[b].ray)) < kMinRaySine;
-  return 2 * grazing > blocks.size();
+  // Only blocks whose rays meet the plane at an angle test it (a grazing block's centroid
+  // lies on any plane along its ray): it is seen edge-on when they are too few to be a
+  // region on their own, however many grazing blocks lie thin along it.
+  double tested_points = 0.0;
+  for (int b : blocks)
+    if (!(std::abs(normal.dot(info_[b].ray)) < kMinRaySine)) tested_points += grid_.block(b).count;
+  return tested_points < params_.min_support;
 }
 
 bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const

@@ -341,21 +341,7 @@ bool PlanarityTests::ownNormal(const std::vector<int>& blocks, OwnNormal& own) c
 
 bool PlanarityTests::isThinAlong(int block, const Eigen::Vector3d& n_cam) const
 {
-  const BlockInfo& info = frame_.blocks[block];
-  const double points = frame_.points(block);
-  const double thickness = n_cam.dot(info.covariance * n_cam);
-  // Without a noise model (or a spread to judge) only the block's fixed thickness_limit applies.
-  if (!(info.random_depth_variance > 0.0) || points < 2.0) return thickness <= info.thickness_limit;
-  // A depth error moves a point along its ray: by ray / ray.z per metre of depth.
-  const double along_normal = n_cam.dot(info.ray) / info.ray.z();
-  // The random part's sample variance (points - 1 degrees of freedom; the covariance divides
-  // by the count) within its p = 0.01 bound; quantization errors lie within half a step, so
-  // their variance is at most a quarter step squared (points split over two levels).
-  const double random = info.random_depth_variance * noiseBoundOfMeanChi2(static_cast<size_t>(points - 1.0)) *
-                        (points - 1.0) / points;
-  const double bound = (random + 0.25 * info.quantization_step * info.quantization_step) * along_normal * along_normal +
-                       kFaceRoughness * kFaceRoughness;
-  return thickness <= std::min(bound, info.thickness_limit);
+  return blockThinAlong(frame_.blocks[block], frame_.points(block), n_cam);
 }
 
 double PlanarityTests::centroidChi2(const Eigen::Vector3d& n_cam, double d_cam, const std::vector<int>& blocks) const

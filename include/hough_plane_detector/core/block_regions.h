@@ -50,6 +50,13 @@ struct BlockInfo
   PointMoments weighted_centroid;  // its points moved to their centroid, weighted by fit_weight
 };
 
+// True when the block's points scatter along n_cam no more than their depth noise can (moved
+// along the rays: the random part within its p = 0.01 bound, quantization within half a step):
+// a block across an edge or a step is thicker, and so is one whose rows straddle the image line
+// of a plane through the sensor. Never beyond its thickness_limit; without a noise model (or
+// under 2 points to judge) that limit alone.
+bool blockThinAlong(const BlockInfo& info, double points, const Eigen::Vector3d& n_cam);
+
 // Fills `info` (row-major over the estimator's block grid) from the estimator's last frame,
 // its rows of blocks shared out over `team` (each block is described on its own).
 void describeBlocks(const NormalEstimator& grid, const DetectorParams& params, const DepthNoiseModel& noise,
@@ -180,7 +187,8 @@ public:
   // than `max_turn`. The region itself is not changed.
   bool wholeFacePlane(const PlaneRegion& region, const std::vector<char>& taken, double max_turn,
                       Eigen::Vector3d& normal, double& d);
-  // True when the rays to most of the blocks graze the plane (under ~6 deg).
+  // True when the blocks whose rays do not graze the plane (under ~6 deg) hold fewer than
+  // min_support points.
   bool seenEdgeOn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // True when the block centroids bend away from the plane: a quadric fit explains them
   // significantly better (p < 0.001: its chi^2 drop over 3 degrees of freedom against the

@@ -104,10 +104,7 @@ public:
     Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
   };
   bool ownNormal(const std::vector<int>& blocks, OwnNormal& own) const;
-  // The block's points scatter along n_cam no more than their depth noise can (moved along
-  // the rays: the random part within its p = 0.01 bound, quantization within half a step):
-  // a block across an edge or a step is thicker. Never beyond the block's thickness_limit;
-  // without a noise model, that limit alone.
+  // blockThinAlong (block_regions.h) of one of the frame's blocks.
   bool isThinAlong(int block, const Eigen::Vector3d& n_cam) const;
   // A block centroid's variance about its true plane (its noise and kCentroidFloor), and its inverse.
   double centroidVariance(int block) const { return frame_.blocks[block].centroid_variance + kCentroidFloor; }
