@@ -655,9 +655,12 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
     const double offset = -n_cam.dot(info.centroid);
     // Along a grazing ray only the sine's share of the depth error lies along the normal: a
     // block of the surface behind an edge-on face is far off its plane in that noise.
-    const double sine = std::abs(n_cam.dot(info.ray));
-    const double variance = seen_edge_on ? tests_.centroidVariance(b) * sine * sine + kEdgeOnOffsetFloor * kEdgeOnOffsetFloor
-                                         : tests_.centroidVariance(b);
+    double variance = tests_.centroidVariance(b);
+    if (seen_edge_on)
+    {
+      const double sine = n_cam.dot(info.ray);
+      variance = variance * sine * sine + kEdgeOnOffsetFloor * kEdgeOnOffsetFloor;
+    }
     if (std::abs(offset - median) > 3.0 * std::sqrt(variance)) continue;
     inliers.push_back(b);
     inlier_points += points(b);
