@@ -981,6 +981,28 @@ TEST(PlaneDetector, ATableTopSeenFromJustAboveGrowsOverItsGrazingBlocksAndTakesT
     }
 }
 
+// Development rooms 667, 609, 650 and 321: a stair riser seen between its treads. The tread
+// planes above and below it (and a region fitted across the steps) pass within a riser block's
+// reach by its centroid, but the block spreads over its height along their normal; only a block
+// thin along a known plane lies on it, so the parallel search keeps the riser's blocks (before,
+// its patches were cut into pieces too small to count: "curved patches").
+TEST(PlaneDetector, AStairRiserBetweenItsTreadsIsFoundByTheParallelSearch)
+{
+  struct Riser
+  {
+    uint32_t seed;
+    int frame;
+    const char* name;
+  };
+  for (const Riser& riser : {Riser{667, 18, "stair1_front"}, Riser{609, 12, "stair0_front"},
+                             Riser{650, 12, "stair4_front"}, Riser{321, 9, "stair3_front"}})
+  {
+    const RoomFrame frame = tourDevelopmentRoom(riser.seed, riser.frame, riser.name, 1);
+    ASSERT_GT(frame.visible_points, 2000) << "room " << riser.seed;
+    EXPECT_TRUE(frame.found) << "room " << riser.seed << " " << riser.name << frame.planes;
+  }
+}
+
 // The map's reach is a matter of memory, not of distance from the origin: a corridor's end wall
 // 40 m from where the map began is found when the camera gets near it (the old 10 m reach lost
 // it, counted in lastStats().votes_out_of_range), and the Hough space stays small.

@@ -160,7 +160,10 @@ private:
   }
 
   // Free blocks within their own noise of the cluster's plane; blocks that lie on a known
-  // plane of another tilt (a floor beside a ramp) stay its own.
+  // plane of another tilt (a floor beside a ramp) stay its own. Lying on it takes being thin
+  // along its normal too: a stair riser's blocks are within reach of the tread planes above
+  // and below it (and of a region across the steps) by their centroids, but spread over their
+  // height along those normals.
   void clusterBlocks(double d, std::vector<int>& blocks) const
   {
     blocks.clear();
@@ -173,7 +176,8 @@ private:
       if (frame_.block_claim[it->second] || std::abs(it->first - d) > reach) continue;
       bool on_known = false;
       for (const KnownPlane& plane : known_)
-        if (!sameAsCluster(plane, d) && std::abs(plane.normal_cam.dot(info.centroid) + plane.d_cam) <= reach)
+        if (!sameAsCluster(plane, d) && std::abs(plane.normal_cam.dot(info.centroid) + plane.d_cam) <= reach &&
+            tests_.isThinAlong(it->second, plane.normal_cam))
           on_known = true;
       if (!on_known) blocks.push_back(it->second);
     }
