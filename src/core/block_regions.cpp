@@ -146,6 +146,11 @@ BlockRegionGrower::BlockRegionGrower(const NormalEstimator& grid, const std::vec
 {
 }
 
+bool BlockRegionGrower::grazes(int block, const Eigen::Vector3d& normal) const
+{
+  return std::abs(normal.dot(info_[block].ray)) < kMinRaySine;
+}
+
 bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double d, double warp, bool oriented_only) const
 {
   const BlockInfo& i = info_[block];
@@ -161,8 +166,7 @@ bool BlockRegionGrower::accepts(int block, const Eigen::Vector3d& normal, double
   // lies "on" it by its centroid; but a block whose points are thin along the normal, within
   // the sine's share of their depth noise, lies on it point by point (a table top seen from
   // just above it). Without a noise model no such share is known, and no grazing block joins.
-  return !(std::abs(normal.dot(i.ray)) < kMinRaySine) ||
-         (i.random_depth_variance > 0.0 && blockThinAlong(i, grid_.block(block).count, normal));
+  return !grazes(block, normal) || (i.random_depth_variance > 0.0 && blockThinAlong(i, grid_.block(block).count, normal));
 }
 
 size_t BlockRegionGrower::sweep(std::vector<int>& blocks, const std::vector<char>& taken, const Eigen::Vector3d& normal,
@@ -203,7 +207,7 @@ bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::
   // region on their own, however many grazing blocks lie thin along it.
   double tested_points = 0.0;
   for (int b : blocks)
-    if (!(std::abs(normal.dot(info_[b].ray)) < kMinRaySine)) tested_points += grid_.block(b).count;
+    if (!grazes(b, normal)) tested_points += grid_.block(b).count;
   return tested_points < params_.min_support;
 }
 

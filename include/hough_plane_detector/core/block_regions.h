@@ -207,6 +207,8 @@ public:
   bool fitInterior(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
 
 private:
+  // Its ray meets the plane under ~6 deg: its centroid lies on any plane along that ray.
+  bool grazes(int block, const Eigen::Vector3d& normal) const;
   // One breadth-first sweep from `blocks` over neighbours not taken that accepts() admits;
   // returns how many joined.
   size_t sweep(std::vector<int>& blocks, const std::vector<char>& taken, const Eigen::Vector3d& normal, double d,
