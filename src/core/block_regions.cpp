@@ -9,7 +9,6 @@
 #include <boost/math/distributions/fisher_f.hpp>
 
 #include "hough_plane_detector/core/plane_geometry.h"
-#include "hough_plane_detector/core/planarity_tests.h"
 #include "hough_plane_detector/core/symmetric_eigen.h"
 
 namespace hough_plane_detector

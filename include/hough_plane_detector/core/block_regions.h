@@ -6,6 +6,8 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <limits>
 #include <vector>
 
@@ -49,6 +51,15 @@ struct BlockInfo
   double quantization_step = 0;      // the sensor's depth step there (0: none)
   PointMoments weighted_centroid;  // its points moved to their centroid, weighted by fit_weight
 };
+
+constexpr double kFaceRoughness = 0.001;  // no face is flatter within a block (paint, cardboard), m
+
+// The mean chi^2 per block that n block centroids exceed about their true plane with p = 0.01
+// (chi^2 with n dof over n, its normal approximation).
+inline double noiseBoundOfMeanChi2(size_t blocks)
+{
+  return 1.0 + 2.33 * std::sqrt(2.0 / static_cast<double>(std::max<size_t>(1, blocks)));
+}
 
 // True when the block's points scatter along n_cam no more than their depth noise can (moved
 // along the rays: the random part within its p = 0.01 bound, quantization within half a step):

@@ -19,15 +19,8 @@ namespace hough_plane_detector
 constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
 constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
 constexpr double kMaxSnapChi2Increase = 9.21;      // a known normal's fit: chi^2 with 2 dof, p = 0.01
-constexpr double kFaceRoughness = 0.001;           // no face is flatter within a block (paint, cardboard), m
 constexpr double kLevelSurfaceCosine = 0.9;        // within 26 deg of level: what one walks or sets things on
 
-// The mean chi^2 per block that n block centroids exceed about their true plane with p = 0.01
-// (chi^2 with n dof over n, its normal approximation).
-inline double noiseBoundOfMeanChi2(size_t blocks)
-{
-  return 1.0 + 2.33 * std::sqrt(2.0 / static_cast<double>(std::max<size_t>(1, blocks)));
-}
 
 // The value an F statistic with (2, dof) degrees of freedom exceeds with probability p: its
 // tail is (1 + 2 F / dof)^(-dof / 2), so this is exact.
