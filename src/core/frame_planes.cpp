@@ -306,14 +306,24 @@ void FramePlaneFitter::testFitToBlocks(FramePlane& plane, const std::vector<int>
   // uncertainty: a region that took blocks of a neighbouring face or bends along a curve fails
   // one of them. It mixes surfaces when that chi^2 is beyond what noise reaches once in a
   // hundred regions; real faces (osd-learn's boxes) often fail the interior test, not this one.
-  plane.fits_its_blocks = plane.mixes_surfaces = false;
+  plane.fits_its_blocks = plane.mixes_surfaces = plane.level_strip = false;
   if (blocks.empty()) return;
   const Eigen::Vector3d n_cam = frame_.normalInCamera(plane.normal);
   const double mean_chi2 = tests_.centroidChi2(n_cam, frame_.dInCamera(plane.normal, plane.d), blocks);
   plane.mixes_surfaces = mean_chi2 > noiseBoundOfMeanChi2(blocks.size());
   if (mean_chi2 > 1.0) return;
   const std::vector<int> interior = interiorBlocks(blocks, frame_.blocksX(), frame_.blocksY());
-  if (interior.size() < kMinInteriorBlocks) return;
+  if (interior.size() < kMinInteriorBlocks)
+  {
+    // A strip without an interior cannot show a fold by its own plane. A snap onto the
+    // vertical with the world's up known took its direction from gravity, which keeps level
+    // surfaces parallel (a tread seen as a strip, a far table top): only its offset is
+    // measured, and the centroids' chi^2 has tested that. Level: within half the merge angle,
+    // as one map's level planes are; a ramp's normal (5-20 deg) is not gravity's.
+    plane.level_strip = plane.parallel && params_.world_z_up &&
+                        unsignedAngle(plane.normal, Eigen::Vector3d::UnitZ()) <= params_.merge_angle / 2.0;
+    return;
+  }
   Eigen::Vector3d interior_normal;
   if (!tests_.weightedMoments(interior).planeNormal(interior_normal)) return;
   // An upright plane's sigma is of its turn about the vertical: the interior is judged on that

@@ -417,19 +417,20 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
     }
   }
   if (support < 2.0 * params_.min_support && !(plane.parallel && points >= strong_support)) return 1.0f;
-  // A region whose blocks pass the noise tests of a plane (FramePlane::fits_its_blocks) is a
-  // complete measurement of a new surface whatever its size: one frame reports it, when it is
-  // precise enough that a second measurement would agree with it. Near a known plane it may be
-  // that plane measured badly, and waits for a second frame; not near one this frame's
-  // measurements just replaced.
-  if (!plane.fits_its_blocks)
+  // A region whose blocks pass the noise tests of a plane (FramePlane::fits_its_blocks, or
+  // level_strip's offset test) is a complete measurement of a new surface whatever its size:
+  // one frame reports it, when it is precise enough that a second measurement would agree
+  // with it. Near a known plane it may be that plane measured badly, and waits for a second
+  // frame; not near one this frame's measurements just replaced.
+  const bool fits = plane.fits_its_blocks || plane.level_strip;
+  if (!fits)
     first_sight = plane.blocks.empty() ? FirstSight::kWithoutBlocks : FirstSight::kNotFittingItsBlocks;
   else if (!preciseAtFirstSight(plane, frame_planes))
     first_sight = FirstSight::kImprecise;
   else
     first_sight = nearKnownPlane(plane, dropped) ? FirstSight::kNearKnownPlane : FirstSight::kComplete;
   if (first_sight == FirstSight::kComplete) return 2.0f;
-  const bool offset_only = plane.parallel && (plane.blocks.empty() || plane.fits_its_blocks);
+  const bool offset_only = plane.parallel && (plane.blocks.empty() || fits);
   const double bar = offset_only ? 0.25 * strong_support : strong_support;
   return static_cast<float>(1.0 + std::min(1.0, plane.first_sight_points / bar));
 }
