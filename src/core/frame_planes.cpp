@@ -290,6 +290,10 @@ FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d
   plane.value = value;
   plane.support = support;
   plane.parallel = parallel;
+  // Level: within half the merge angle of the vertical, as one map's level planes are; a ramp's
+  // normal (5-20 deg) is not gravity's.
+  plane.level_snap = parallel && params_.world_z_up &&
+                     unsignedAngle(normal, Eigen::Vector3d::UnitZ()) <= params_.merge_angle / 2.0;
   plane.first_sight_points = tests_.firstSightPoints(blocks);
   plane.blocks = blocks;
   plane.normal_sigma = normal_sigma;
@@ -315,13 +319,10 @@ void FramePlaneFitter::testFitToBlocks(FramePlane& plane, const std::vector<int>
   const std::vector<int> interior = interiorBlocks(blocks, frame_.blocksX(), frame_.blocksY());
   if (interior.size() < kMinInteriorBlocks)
   {
-    // A strip without an interior cannot show a fold by its own plane. A snap onto the
-    // vertical with the world's up known took its direction from gravity, which keeps level
-    // surfaces parallel (a tread seen as a strip, a far table top): only its offset is
-    // measured, and the centroids' chi^2 has tested that. Level: within half the merge angle,
-    // as one map's level planes are; a ramp's normal (5-20 deg) is not gravity's.
-    plane.level_strip = plane.parallel && params_.world_z_up &&
-                        unsignedAngle(plane.normal, Eigen::Vector3d::UnitZ()) <= params_.merge_angle / 2.0;
+    // A strip without an interior cannot show a fold by its own plane. A level snap took its
+    // direction from gravity (a tread seen as a strip, a far table top): only its offset is
+    // measured, and the centroids' chi^2 has tested that.
+    plane.level_strip = plane.level_snap;
     return;
   }
   Eigen::Vector3d interior_normal;

@@ -477,6 +477,9 @@ bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const
 {
   if (preciseAtFirstSight(measured)) return true;
+  // A level snap's normal is gravity's, as precise as the map's level planes: its offset is
+  // what it measured.
+  if (measured.level_snap) return kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance;
   return kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance &&
          kFirstSightSigmas * sharedDirectionSigma(measured, frame_planes) <= params_.merge_angle;
 }

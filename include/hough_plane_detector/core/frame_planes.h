@@ -64,9 +64,11 @@ struct FramePlane
   // region leaning over a fold or a curve fails (the first-sight report, plane_map.cpp). A
   // snapped plane is judged on the blocks the snap measured it with.
   bool fits_its_blocks = false;
-  // Snapped onto the vertical with the world's up known, and its blocks fit that offset, but
-  // they have no interior to test: gravity gave its direction, so one frame may report it
-  // (first sight). It is not a measurement that keeps a map plane out of view
+  // Snapped onto the vertical with the world's up known: its normal is gravity's, which keeps
+  // level surfaces parallel, not its blocks' (FramePlaneFitter::regionPlane).
+  bool level_snap = false;
+  // A level snap whose blocks fit its offset but have no interior to test: one frame may report
+  // it (first sight). It is not a measurement that keeps a map plane out of view
   // (measuresOneSurface): without an interior its blocks cannot show a curve.
   bool level_strip = false;
   // Its blocks' centroids lie off it beyond their noise (p = 0.01, noiseBoundOfMeanChi2): it

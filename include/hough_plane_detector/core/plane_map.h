@@ -128,7 +128,8 @@ private:
   // the merge tolerances of it: its normal, and its offset at its own points.
   bool preciseAtFirstSight(const FramePlane& measured) const;
   // The same, with a snapped plane's normal judged by every new surface of the frame that took
-  // the same known direction (sharedDirectionSigma): a staircase's risers, a shelf's boards.
+  // the same known direction (sharedDirectionSigma): a staircase's risers, a shelf's boards;
+  // a level snap's (FramePlane::level_snap) by its offset alone.
   bool preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const;
   // The standard error (rad) of the direction that the snapped new planes of `frame_planes`
   // sharing `snapped`'s known normal measure together: their own normals pooled by their
