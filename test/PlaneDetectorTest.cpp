@@ -951,6 +951,24 @@ RoomFrame tourDevelopmentRoom(uint32_t seed, int last_frame, const std::string& 
   result.planes = describe(detector.planes());
   return result;
 }
+
+// Each development room, toured at C = 1 with up known up to its frame, has its true plane in
+// the map then.
+struct RoomPlane
+{
+  uint32_t seed;
+  int frame;
+  const char* name;
+};
+void expectFoundAtC1(const std::vector<RoomPlane>& cases)
+{
+  for (const RoomPlane& c : cases)
+  {
+    const RoomFrame frame = tourDevelopmentRoom(c.seed, c.frame, c.name, 1);
+    ASSERT_GT(frame.visible_points, 2000) << "room " << c.seed;
+    EXPECT_TRUE(frame.found) << "room " << c.seed << " " << c.name << frame.planes;
+  }
+}
 }  // namespace
 
 // Development rooms 622 (frame 18) and 620 (frame 6): the camera stands 6.5 and 14 cm above a
@@ -988,19 +1006,8 @@ TEST(PlaneDetector, ATableTopSeenFromJustAboveGrowsOverItsGrazingBlocksAndTakesT
 // its patches were cut into pieces too small to count: "curved patches").
 TEST(PlaneDetector, AStairRiserBetweenItsTreadsIsFoundByTheParallelSearch)
 {
-  struct Riser
-  {
-    uint32_t seed;
-    int frame;
-    const char* name;
-  };
-  for (const Riser& riser : {Riser{667, 18, "stair1_front"}, Riser{609, 12, "stair0_front"},
-                             Riser{650, 12, "stair4_front"}, Riser{321, 9, "stair3_front"}})
-  {
-    const RoomFrame frame = tourDevelopmentRoom(riser.seed, riser.frame, riser.name, 1);
-    ASSERT_GT(frame.visible_points, 2000) << "room " << riser.seed;
-    EXPECT_TRUE(frame.found) << "room " << riser.seed << " " << riser.name << frame.planes;
-  }
+  expectFoundAtC1({{667, 18, "stair1_front"}, {609, 12, "stair0_front"}, {650, 12, "stair4_front"},
+                   {321, 9, "stair3_front"}});
 }
 
 // Development rooms 627, 658, 659 and 651: a level surface first seen as a strip too narrow for
@@ -1010,19 +1017,8 @@ TEST(PlaneDetector, AStairRiserBetweenItsTreadsIsFoundByTheParallelSearch)
 // a second frame: "seen, not yet in the map: does not fit its blocks").
 TEST(PlaneDetector, ALevelStripSnappedToTheFloorsNormalIsReportedAtFirstSight)
 {
-  struct Strip
-  {
-    uint32_t seed;
-    int frame;
-    const char* name;
-  };
-  for (const Strip& strip : {Strip{627, 3, "table0_top"}, Strip{658, 6, "shelf_board_top2"},
-                             Strip{659, 15, "stair2_top"}, Strip{651, 15, "box0_top"}})
-  {
-    const RoomFrame frame = tourDevelopmentRoom(strip.seed, strip.frame, strip.name, 1);
-    ASSERT_GT(frame.visible_points, 2000) << "room " << strip.seed;
-    EXPECT_TRUE(frame.found) << "room " << strip.seed << " " << strip.name << frame.planes;
-  }
+  expectFoundAtC1({{627, 3, "table0_top"}, {658, 6, "shelf_board_top2"}, {659, 15, "stair2_top"},
+                   {651, 15, "box0_top"}});
 }
 
 // Development rooms 633 (frame 3) and 674 (frame 9): a shelf board's top seen as a narrow
@@ -1032,12 +1028,7 @@ TEST(PlaneDetector, ALevelStripSnappedToTheFloorsNormalIsReportedAtFirstSight)
 // in the map: imprecise at first sight").
 TEST(PlaneDetector, ALevelSnapIsPreciseAtFirstSightByItsOffset)
 {
-  for (const auto& [seed, last_frame] : {std::make_pair(633u, 3), std::make_pair(674u, 9)})
-  {
-    const RoomFrame frame = tourDevelopmentRoom(seed, last_frame, "shelf_board_top0", 1);
-    ASSERT_GT(frame.visible_points, 2000) << "room " << seed;
-    EXPECT_TRUE(frame.found) << "room " << seed << frame.planes;
-  }
+  expectFoundAtC1({{633, 3, "shelf_board_top0"}, {674, 9, "shelf_board_top0"}});
 }
 
 // The map's reach is a matter of memory, not of distance from the origin: a corridor's end wall
