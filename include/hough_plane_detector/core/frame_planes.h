@@ -137,8 +137,8 @@ private:
   void describeMeasurement(FramePlane& plane, const std::vector<int>& blocks) const;
   // A snapped plane's own_normal and its information, from the blocks that measured it.
   void recordOwnNormal(FramePlane& plane, const std::vector<int>& measured_by) const;
-  // FramePlane::fits_its_blocks and mixes_surfaces: how the blocks' centroids, and the interior's
-  // own plane, agree with (normal, d) within the sensor's noise.
+  // FramePlane::fits_its_blocks, level_strip and mixes_surfaces: how the blocks' centroids, and
+  // the interior's own plane, agree with (normal, d) within the sensor's noise.
   void testFitToBlocks(FramePlane& plane, const std::vector<int>& blocks) const;
   // A region's accepted plane (world frame) as the map receives it; normal_sigma is
   // PlanarityTests::normalUncertainty of its blocks, which the caller has already computed.

@@ -21,7 +21,6 @@ constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a pl
 constexpr double kMaxSnapChi2Increase = 9.21;      // a known normal's fit: chi^2 with 2 dof, p = 0.01
 constexpr double kLevelSurfaceCosine = 0.9;        // within 26 deg of level: what one walks or sets things on
 
-
 // The value an F statistic with (2, dof) degrees of freedom exceeds with probability p: its
 // tail is (1 + 2 F / dof)^(-dof / 2), so this is exact.
 inline double fCriticalTwo(double dof, double p)
