@@ -1031,6 +1031,16 @@ TEST(PlaneDetector, ALevelSnapIsPreciseAtFirstSightByItsOffset)
   expectFoundAtC1({{633, 3, "shelf_board_top0"}, {674, 9, "shelf_board_top0"}});
 }
 
+// Development room 308 (frame 9): a shelf board's top, snapped to the floor's normal, climbs to
+// the map's peak of another level surface. A peak is split between the surfaces the frame
+// measured apart when each is trusted: it fits its blocks and is precise at first sight. A
+// level snap's normal is gravity's, so its offset alone makes it precise, there too (before:
+// "seen, one map plane with another surface").
+TEST(PlaneDetector, APeakIsSplitBetweenLevelSnapsByTheirOffsets)
+{
+  expectFoundAtC1({{308, 9, "shelf_board_top1"}});
+}
+
 // The map's reach is a matter of memory, not of distance from the origin: a corridor's end wall
 // 40 m from where the map began is found when the camera gets near it (the old 10 m reach lost
 // it, counted in lastStats().votes_out_of_range), and the Hough space stays small.

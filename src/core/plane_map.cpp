@@ -470,16 +470,15 @@ bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 {
   // The offset is judged where the surface was measured, at its points: a far face's small
   // tilt error moves its offset at the world origin, not the surface shown.
-  return kFirstSightSigmas * measured.normal_sigma <= params_.merge_angle &&
-         kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance;
+  const bool offset_precise = kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance;
+  // A level snap's normal is gravity's, as precise as the map's level planes.
+  if (measured.level_snap) return offset_precise;
+  return offset_precise && kFirstSightSigmas * measured.normal_sigma <= params_.merge_angle;
 }
 
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const
 {
   if (preciseAtFirstSight(measured)) return true;
-  // A level snap's normal is gravity's, as precise as the map's level planes: its offset is
-  // what it measured.
-  if (measured.level_snap) return kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance;
   return kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance &&
          kFirstSightSigmas * sharedDirectionSigma(measured, frame_planes) <= params_.merge_angle;
 }

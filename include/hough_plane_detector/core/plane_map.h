@@ -125,11 +125,11 @@ private:
   // them) do not count: the measurement is what replaced them.
   bool nearKnownPlane(const FramePlane& measured, const std::vector<char>& dropped) const;
   // True when the frame's plane is precise enough that a second measurement of it falls within
-  // the merge tolerances of it: its normal, and its offset at its own points.
+  // the merge tolerances of it: its normal, and its offset at its own points. A level snap's
+  // (FramePlane::level_snap) normal is gravity's: its offset alone is judged.
   bool preciseAtFirstSight(const FramePlane& measured) const;
   // The same, with a snapped plane's normal judged by every new surface of the frame that took
-  // the same known direction (sharedDirectionSigma): a staircase's risers, a shelf's boards;
-  // a level snap's (FramePlane::level_snap) by its offset alone.
+  // the same known direction (sharedDirectionSigma): a staircase's risers, a shelf's boards.
   bool preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const;
   // The standard error (rad) of the direction that the snapped new planes of `frame_planes`
   // sharing `snapped`'s known normal measure together: their own normals pooled by their
