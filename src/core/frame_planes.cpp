@@ -290,10 +290,8 @@ FramePlane FramePlaneFitter::regionPlane(const Eigen::Vector3d& normal, double d
   plane.value = value;
   plane.support = support;
   plane.parallel = parallel;
-  // Level: within half the merge angle of the vertical, as one map's level planes are; a ramp's
-  // normal (5-20 deg) is not gravity's.
-  plane.level_snap = parallel && params_.world_z_up &&
-                     unsignedAngle(normal, Eigen::Vector3d::UnitZ()) <= params_.merge_angle / 2.0;
+  // A ramp's normal (5-20 deg) is not gravity's.
+  plane.level_snap = parallel && params_.world_z_up && isGravityNormal(normal, params_.merge_angle);
   plane.first_sight_points = tests_.firstSightPoints(blocks);
   plane.blocks = blocks;
   plane.normal_sigma = normal_sigma;

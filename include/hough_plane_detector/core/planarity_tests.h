@@ -12,6 +12,7 @@
 
 #include "hough_plane_detector/core/detector_params.h"
 #include "hough_plane_detector/core/frame_data.h"
+#include "hough_plane_detector/core/plane_geometry.h"
 
 namespace hough_plane_detector
 {
@@ -19,7 +20,6 @@ namespace hough_plane_detector
 constexpr double kCentroidFloor = 0.001 * 0.001;  // pose and calibration jitter, in m^2
 constexpr double kMaxMeanCentroidChi2 = 4.0;       // block centroids about a plane, per block
 constexpr double kMaxSnapChi2Increase = 9.21;      // a known normal's fit: chi^2 with 2 dof, p = 0.01
-constexpr double kLevelSurfaceCosine = 0.9;        // within 26 deg of level: what one walks or sets things on
 
 // The value an F statistic with (2, dof) degrees of freedom exceeds with probability p: its
 // tail is (1 + 2 F / dof)^(-dof / 2), so this is exact.
@@ -70,7 +70,7 @@ public:
   bool acceptsKnownNormal(const NormalExplanation& explained, const Eigen::Vector3d& known_normal) const
   {
     const bool judged_on_own_scatter =
-        params_.world_z_up && params_.region_growing && std::abs(known_normal.z()) < kLevelSurfaceCosine;
+        params_.world_z_up && params_.region_growing && !isLevelSurfaceNormal(known_normal);
     return explained.interior && (!judged_on_own_scatter || explained.interior_within_own_scatter);
   }
   // How much more chi^2 the block centroids have about their best plane of the camera-frame

@@ -17,6 +17,20 @@ inline double unsignedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
   return std::acos(std::min(1.0, std::abs(a.dot(b))));
 }
 
+// With the world's up known (REP 103: +z up), "level" means two things. A surface one walks on
+// or sets things on lies within 26 deg of level, ramps included; gravity's own direction, which
+// keeps such surfaces parallel to a fraction of a degree (floor, treads, table and shelf tops),
+// is the vertical within half the merge angle, as one map's level planes are.
+constexpr double kLevelSurfaceCosine = 0.9;  // cos 26 deg
+inline bool isLevelSurfaceNormal(const Eigen::Vector3d& world_normal)
+{
+  return std::abs(world_normal.z()) >= kLevelSurfaceCosine;
+}
+inline bool isGravityNormal(const Eigen::Vector3d& world_normal, double merge_angle)
+{
+  return unsignedAngle(world_normal, Eigen::Vector3d::UnitZ()) <= merge_angle / 2.0;
+}
+
 // Eq. 7-8: two planes are one when both their normals' angle and their offsets' difference
 // (after aligning the normals' signs) are under the merge tolerances.
 inline bool withinMergeTolerances(const Eigen::Vector3d& normal_a, double d_a, const Eigen::Vector3d& normal_b,
