@@ -400,7 +400,7 @@ RandomSceneExperiment runRandomScenes(bool quick)
     const TourScoring scoring = roomTourScoring(denser);
     for (int f = 0; f < frames * denser; ++f)
     {
-      const RenderedFrame frame = renderer.render(room.poses[f], noise, seed * 1000 + f);
+      const RenderedFrame frame = renderer.render(room.poses[f], noise, room.noiseSeed(f));
       for (auto& detector : detectors) detector->processFrame(frame.view(), frame.camera_to_world, 0.1 * f);
       if (!scoring.scored(f)) continue;
       for (size_t v = 0; v < used; ++v)

@@ -108,7 +108,8 @@ std::string describeFalsePlane(const std::string& where, int frame, const PlaneD
 
 using ParamsFor = std::function<DetectorParams(double noise)>;
 
-// One camera path through one scene, scored at `scoring`'s frames.
+// One camera path through one scene, scored at `scoring`'s frames; frame f's pixel noise is
+// seeded noise_seed + f (a room's first: RandomScene::noiseSeed(0)).
 void runSequence(const std::string& where, const Scene& scene, const std::vector<Eigen::Isometry3d>& poses, double noise,
                  uint32_t noise_seed, const TourScoring& scoring, const DetectorParams& params, SetResult& result)
 {
@@ -153,7 +154,7 @@ SetResult runRooms(const char* name, const std::vector<uint32_t>& seeds, const P
     RandomScene room = makeRandomScene(seed, room_frames);
     if (noise_override > 0.0) room.noise = noise_override;
     // The room's own noise seeds and scored frames, as make evaluate renders and scores them.
-    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, seed * 1000,
+    runSequence("seed " + std::to_string(seed), room.scene, room.poses, room.noise, room.noiseSeed(0),
                 roomTourScoring(room_frames / kRoomFrames), params_for(room.noise), result);
   }
   return result;

@@ -939,7 +939,7 @@ RoomFrame tourDevelopmentRoom(uint32_t seed, int last_frame, const std::string& 
   RenderedFrame frame;
   for (int f = 0; f <= last_frame; ++f)
   {
-    frame = renderer.render(room.poses[f], kinect(1.0), seed * 1000 + f);
+    frame = renderer.render(room.poses[f], kinect(1.0), room.noiseSeed(f));
     feed(detector, frame, 0.1 * f);
   }
   result.visible_points = frame.visible_points[index];

@@ -22,6 +22,9 @@ struct RandomScene
   std::vector<Eigen::Isometry3d> poses;  // the camera's tour
   double noise = 1.0;                    // C of eq. 11 for this scene, in [0.5, 2]
   std::string description;               // what the room holds, for reports
+  // The pixel-noise seed of the tour's frame `frame`, as make evaluate, tuning_check and the
+  // tests render it: the same room, frame and C give the same depths everywhere.
+  uint32_t noiseSeed(int frame) const { return seed * 1000 + static_cast<uint32_t>(frame); }
 };
 
 // The room of a seed; the same seed always gives the same room, tour and noise.
