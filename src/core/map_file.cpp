@@ -177,7 +177,7 @@ std::string readPlanes(Reader& r, std::vector<DetectedPlane>& planes)
   planes.resize(plane_count);
   for (DetectedPlane& p : planes)
   {
-    int32_t id, support;
+    int32_t id = 0, support = 0;  // used only when read (`ok`); zeroed for -Wmaybe-uninitialized
     bool ok = r.get(id);
     for (int i = 0; i < 3; ++i) ok = ok && r.get(p.normal(i));
     ok = ok && r.get(p.d) && r.get(p.strength) && r.get(support) && r.get(p.first_seen) && r.get(p.last_seen);
