@@ -1031,11 +1031,12 @@ TEST(PlaneDetector, ALevelSnapIsPreciseAtFirstSightByItsOffset)
   expectFoundAtC1({{633, 3, "shelf_board_top0"}, {674, 9, "shelf_board_top0"}});
 }
 
-// Development room 308 (frame 9): a shelf board's top, snapped to the floor's normal, climbs to
-// the map's peak of another level surface. A peak is split between the surfaces the frame
-// measured apart when each is trusted: it fits its blocks and is precise at first sight. A
+// Development room 308 (frame 9): a shelf board's top and a box top 1.9 cm above it, both
+// snapped to the floor's normal, climb to one peak of the map. A peak is split between the
+// surfaces the frame measured apart when each is trusted: it fits its blocks and is precise at
+// first sight. The box top's own blocks orient it only to 0.02 rad, too loosely for that; but a
 // level snap's normal is gravity's, so its offset alone makes it precise, there too (before:
-// "seen, one map plane with another surface").
+// the board was "seen, one map plane with another surface").
 TEST(PlaneDetector, APeakIsSplitBetweenLevelSnapsByTheirOffsets)
 {
   expectFoundAtC1({{308, 9, "shelf_board_top1"}});
