@@ -464,13 +464,18 @@ namespace
 // Two measurements of one surface differ by sqrt(2) sigma; a tolerance holds at 2 sigma of that
 // difference.
 constexpr double kFirstSightSigmas = 2.0 * M_SQRT2;
+
+// The offset is judged where the surface was measured, at its points: a far face's small tilt
+// error moves its offset at the world origin, not the surface shown.
+bool offsetPreciseAtFirstSight(const FramePlane& measured, double merge_distance)
+{
+  return kFirstSightSigmas * measured.offset_sigma <= merge_distance;
+}
 }  // namespace
 
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 {
-  // The offset is judged where the surface was measured, at its points: a far face's small
-  // tilt error moves its offset at the world origin, not the surface shown.
-  const bool offset_precise = kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance;
+  const bool offset_precise = offsetPreciseAtFirstSight(measured, params_.merge_distance);
   // A level snap's normal is gravity's, as precise as the map's level planes.
   if (measured.level_snap) return offset_precise;
   return offset_precise && kFirstSightSigmas * measured.normal_sigma <= params_.merge_angle;
@@ -479,7 +484,7 @@ bool PlaneMap::preciseAtFirstSight(const FramePlane& measured) const
 bool PlaneMap::preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const
 {
   if (preciseAtFirstSight(measured)) return true;
-  return kFirstSightSigmas * measured.offset_sigma <= params_.merge_distance &&
+  return offsetPreciseAtFirstSight(measured, params_.merge_distance) &&
          kFirstSightSigmas * sharedDirectionSigma(measured, frame_planes) <= params_.merge_angle;
 }
 
