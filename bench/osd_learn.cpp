@@ -112,11 +112,12 @@ std::vector<Eigen::Vector4d> mapPlanes(const PlaneDetector& detector)
   return out;
 }
 
-// What became of the candidate nearest to a missed entry in our detector's last frame.
-std::string missReason(const PlaneDetector& detector, const Entry& entry)
+// What became of the candidate nearest to a missed entry in our detector's last frame;
+// `nearest_offsets` receives how far that candidate lies from the entry.
+std::string missReason(const PlaneDetector& detector, const Entry& entry, std::string* nearest_offsets)
 {
   const PlaneCandidate* nearest = nullptr;
-  double nearest_cost = 1e9;
+  double nearest_cost = 1e9, nearest_angle = 0.0, nearest_offset = 0.0;
   for (const PlaneCandidate& c : detector.lastCandidates())
   {
     double a, dd;
@@ -126,13 +127,21 @@ std::string missReason(const PlaneDetector& detector, const Entry& entry)
     {
       nearest_cost = cost;
       nearest = &c;
+      nearest_angle = a;
+      nearest_offset = dd;
     }
+  }
+  if (nearest)
+  {
+    char offsets[64];
+    std::snprintf(offsets, sizeof(offsets), "%.3f rad, %.1f mm", nearest_angle, 1000.0 * nearest_offset);
+    *nearest_offsets = offsets;
   }
   if (!nearest || nearest_cost > 4.0) return "no Hough peak near it";
   std::string reason = toString(nearest->verdict);
   if (nearest_cost > 2.0) return "nearest peak far off (" + reason + ")";
   if (nearest->verdict != CandidateVerdict::kAccepted) return reason;
-  if (nearest_cost > 1.0) return "accepted, fitted beyond the tolerance";
+  if (!matches(nearest->normal, nearest->d, entry)) return "accepted, fitted beyond the tolerance";
   // A map plane that matches it but counted for an entry it fits better: one plane for both.
   for (const DetectedPlane& plane : detector.planes())
     if (matches(plane.normal, plane.d, entry)) return "accepted, one map plane with another entry";
@@ -431,7 +440,11 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
       for (size_t i = 0; i < entries.size(); ++i)
         if (!found[i])
         {
-          OsdMiss miss{name, entries[i].name, entries[i].points, missReason(detector, entries[i])};
+          OsdMiss miss;
+          miss.frame = name;
+          miss.entry = entries[i].name;
+          miss.points = entries[i].points;
+          miss.reason = missReason(detector, entries[i], &miss.nearest_offsets);
           ++results.misses_by_reason[miss.reason];
           results.misses.push_back(miss);
         }
@@ -510,11 +523,11 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
   if (!results.rim_checks.empty()) md += "\n" + osdRimMarkdown(results);
   md += "\nOur misses (one frame), by what became of the nearest candidate:";
   for (const auto& [reason, count] : results.misses_by_reason) md += " " + reason + ": " + std::to_string(count) + ";";
-  md += "\n\n| frame | entry | points | why |\n|---|---|---|---|\n";
+  md += "\n\n| frame | entry | points | why | nearest candidate off by |\n|---|---|---|---|---|\n";
   for (const OsdMiss& miss : results.misses)
   {
-    std::snprintf(line, sizeof(line), "| %s | %s | %d | %s |\n", miss.frame.c_str(), miss.entry.c_str(), miss.points,
-                  miss.reason.c_str());
+    std::snprintf(line, sizeof(line), "| %s | %s | %d | %s | %s |\n", miss.frame.c_str(), miss.entry.c_str(),
+                  miss.points, miss.reason.c_str(), miss.nearest_offsets.empty() ? "-" : miss.nearest_offsets.c_str());
     md += line;
   }
   md += "\n";

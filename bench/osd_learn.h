@@ -41,6 +41,7 @@ struct OsdMiss
   std::string frame, entry;
   int points = 0;
   std::string reason;  // what became of its candidate in our detector
+  std::string nearest_offsets;  // that candidate's angle and offset from the entry ("" when none)
 };
 
 // A found entry's normal error (one frame), beside that of the least-squares plane of the
