@@ -81,8 +81,14 @@ TEST(SymmetricEigen, DegenerateMatricesGiveEigensAnswer)
     for (int k = 0; k < 3; ++k)
     {
       EXPECT_EQ(std::isnan(ours.values(k)), std::isnan(closed_form.eigenvalues()(k)));
-      if (!std::isnan(ours.values(k))) EXPECT_EQ(ours.values(k), closed_form.eigenvalues()(k));
+      if (!std::isnan(ours.values(k)))
+      {
+        EXPECT_EQ(ours.values(k), closed_form.eigenvalues()(k));
+      }
     }
-    if (covariance.allFinite()) EXPECT_TRUE(ours.vector.isApprox(closed_form.eigenvectors().col(0)));
+    if (covariance.allFinite())
+    {
+      EXPECT_TRUE(ours.vector.isApprox(closed_form.eigenvectors().col(0)));
+    }
   }
 }
