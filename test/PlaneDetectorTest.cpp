@@ -1042,16 +1042,6 @@ TEST(PlaneDetector, APeakIsSplitBetweenLevelSnapsByTheirOffsets)
   expectFoundAtC1({{308, 9, "shelf_board_top1"}});
 }
 
-// Development rooms 650 (frame 9) and 665 (frame 24): a box top seen as a strip with no
-// interior to test, whose blocks fit the level snap's offset (FramePlane::level_strip), shares
-// a peak of the map with a surface beside it. First sight takes a level strip for a plane whose
-// blocks pass the noise tests, and so does the peak's split (before: the box top was "seen,
-// one map plane with another surface").
-TEST(PlaneDetector, APeakIsSplitForALevelStripAsForAPlaneThatFitsItsBlocks)
-{
-  expectFoundAtC1({{650, 9, "box1_top"}, {665, 24, "box3_top"}});
-}
-
 // The map's reach is a matter of memory, not of distance from the origin: a corridor's end wall
 // 40 m from where the map began is found when the camera gets near it (the old 10 m reach lost
 // it, counted in lastStats().votes_out_of_range), and the Hough space stays small.

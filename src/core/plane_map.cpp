@@ -155,9 +155,9 @@ void PlaneMap::addCloseSurfacePeaks(const std::vector<FramePlane>& frame_planes,
       return unsignedAngle(a.normal, b.normal) <=
              3.0 * std::sqrt(a.normal_sigma * a.normal_sigma + b.normal_sigma * b.normal_sigma);
     };
-    // Both sides of a split are measurements a first sight would report: one whose blocks fail
-    // the noise tests, or that is imprecise, says nothing about a second surface beside it.
-    auto trusted = [&](const FramePlane& p) { return p.passesItsBlockTests() && preciseAtFirstSight(p); };
+    // Both sides of a split are measurements a first sight would report: one that does not fit
+    // its blocks, or is imprecise, says nothing about a second surface beside it.
+    auto trusted = [&](const FramePlane& p) { return p.fits_its_blocks && preciseAtFirstSight(p); };
     std::vector<const FramePlane*> surfaces;
     for (const FramePlane* plane : measured)
       if (surfaces.empty() ||
@@ -422,7 +422,7 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // one frame reports it, when it is precise enough that a second measurement would agree
   // with it. Near a known plane it may be that plane measured badly, and waits for a second
   // frame; not near one this frame's measurements just replaced.
-  const bool fits = plane.passesItsBlockTests();
+  const bool fits = plane.fits_its_blocks || plane.level_strip;
   if (!fits)
     first_sight = plane.blocks.empty() ? FirstSight::kWithoutBlocks : FirstSight::kNotFittingItsBlocks;
   else if (!preciseAtFirstSight(plane, frame_planes))

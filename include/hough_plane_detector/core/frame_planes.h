@@ -85,9 +85,6 @@ struct FramePlane
   // blocks (the parallel search's, tested cluster by cluster; the paper's windows). The map keeps
   // a plane out of view only once such a measurement has supported it (PlaneBelief).
   bool measuresOneSurface() const { return fits_its_blocks || blocks.empty(); }
-  // Its blocks pass the noise tests a first sight asks of a plane: they fit it, or they fit a
-  // level snap's offset where there is no interior to test (level_strip).
-  bool passesItsBlockTests() const { return fits_its_blocks || level_strip; }
 };
 
 class FramePlaneFitter
