@@ -52,6 +52,7 @@ struct SetResult
   MethodStats stats;
   std::vector<RoomCounts> rooms;  // one per camera path, for the intervals over rooms
   std::map<std::string, int> causes;  // our misses by cause
+  std::map<std::string, int> false_kinds;  // false detections by this frame's fit of them and the truth near
   std::vector<std::string> listed;  // one line per false or missed plane of a scored frame
   std::vector<double> sigma_ratios;  // each new fitting region's normal error over its normal_sigma
 };
@@ -75,9 +76,10 @@ void addSigmaRatios(const PlaneDetector& detector, const std::vector<TruePlane>&
   }
 }
 
-// A false plane: where, what, and the true plane nearest it (hidden ones too).
+// A false plane: where, what, and the true plane nearest it (hidden ones too); `kind` receives
+// this frame's fit of it and whether it lies near a true plane (a second plane of one surface).
 std::string describeFalsePlane(const std::string& where, int frame, const PlaneDetector& detector,
-                               const DetectedPlane& plane, const std::vector<TruePlane>& truth)
+                               const DetectedPlane& plane, const std::vector<TruePlane>& truth, std::string* kind)
 {
   const MatchTolerance tolerance;
   double best_cost = 1e9, best_angle = 0.0, best_distance = 0.0;
@@ -96,6 +98,10 @@ std::string describeFalsePlane(const std::string& where, int frame, const PlaneD
   for (const FramePlane& f : detector.lastFramePlanes())
     if (angleError(f.normal, plane.normal) < 0.02 && distanceError(f.normal, f.d, plane.normal, plane.d) < 0.03)
       fitted = f.parallel ? "snapped or parallel search" : "own fit";
+  constexpr double kNearAngle = 0.05, kNearDistance = 0.05;  // rad, m: a duplicate's reach
+  *kind = std::string(fitted) + (best_angle <= kNearAngle && best_distance <= kNearDistance
+                                     ? ", within 0.05 rad and 5 cm of a true plane"
+                                     : ", off every true plane");
   char line[400];
   std::snprintf(line, sizeof(line),
                 "%s frame %2d: id %d n (%+.3f %+.3f %+.3f) d %+.3f support %d, seen %.1f s, depths confirmed it "
@@ -129,8 +135,12 @@ void runSequence(const std::string& where, const Scene& scene, const std::vector
                                                evaluatedPlanes(detector.planes()));
     room.add(metrics);
     for (int k : metrics.false_indices)
-      result.listed.push_back("false: " +
-          describeFalsePlane(where, static_cast<int>(f), detector, detector.planes()[k], renderer.truePlanes()));
+    {
+      std::string kind;
+      result.listed.push_back("false: " + describeFalsePlane(where, static_cast<int>(f), detector, detector.planes()[k],
+                                                             renderer.truePlanes(), &kind));
+      ++result.false_kinds[kind];
+    }
     for (int missed : metrics.missed)
     {
       const TruePlane& truth = renderer.truePlanes()[missed];
@@ -269,6 +279,8 @@ void print(const SetResult& r, bool causes, bool list, const RoomsBySet& earlier
     for (const std::string& line : r.listed) std::printf("    %s\n", line.c_str());
   if (!causes) return;
   for (const auto& cause : r.causes) std::printf("    %4d  %s\n", cause.second, cause.first.c_str());
+  if (!r.false_kinds.empty()) std::printf("    false detections, by this frame's fit of them and the truth near them:\n");
+  for (const auto& kind : r.false_kinds) std::printf("    %4d  %s\n", kind.second, kind.first.c_str());
 }
 }  // namespace
 
@@ -286,7 +298,8 @@ int main(int argc, char** argv)
        "each room's C), development-c-c1 (the same at C = 1, the held-out verdict's condition; not in the default), "
        "table3, other, fig7 (default: all but development-c-c1)")
       ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
-      ("causes", "our misses of each set by what became of their candidate")
+      ("causes", "our misses of each set by what became of their candidate, and its false detections by this "
+                 "frame's fit of them and whether a true plane lies near")
       ("sigma-calibration", "how far new surfaces' own fits lie off their true planes, in their normal_sigma")
       ("noise-correlation", po::value(&noise_correlation_px)->value_name("PX"),
        "render spatially correlated noise, a field smoothed over PX pixels (real frames' structure; default 0: "
