@@ -99,9 +99,10 @@ std::string describeFalsePlane(const std::string& where, int frame, const PlaneD
     if (angleError(f.normal, plane.normal) < 0.02 && distanceError(f.normal, f.d, plane.normal, plane.d) < 0.03)
       fitted = f.parallel ? "snapped or parallel search" : "own fit";
   constexpr double kNearAngle = 0.05, kNearDistance = 0.05;  // rad, m: a duplicate's reach
-  *kind = std::string(fitted) + (best_angle <= kNearAngle && best_distance <= kNearDistance
-                                     ? ", within 0.05 rad and 5 cm of a true plane"
-                                     : ", off every true plane");
+  char near[96];
+  std::snprintf(near, sizeof(near), ", within %.2f rad and %.0f cm of a true plane", kNearAngle, 100.0 * kNearDistance);
+  *kind = std::string(fitted) +
+          (best_angle <= kNearAngle && best_distance <= kNearDistance ? near : ", off every true plane");
   char line[400];
   std::snprintf(line, sizeof(line),
                 "%s frame %2d: id %d n (%+.3f %+.3f %+.3f) d %+.3f support %d, seen %.1f s, depths confirmed it "
