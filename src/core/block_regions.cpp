@@ -265,6 +265,35 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
   return false;
 }
 
+bool BlockRegionGrower::continuesAndBends(const std::vector<int>& blocks, const Eigen::Vector3d& normal,
+                                          double d) const
+{
+  const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
+  around_.clear(info_.size());
+  for (int b : blocks) around_.insert(b);
+  std::vector<int> extended = blocks;
+  size_t boundary = 0;  // the blocks around it and its sides on the image's edge
+  const double crease_cosine = std::cos(kCreaseAngle);
+  for (int b : blocks)
+  {
+    // Beyond the image's edge the surface is unknown: it counts as a boundary.
+    const int bx = b % bx_count, by = b / bx_count;
+    boundary += (bx == 0) + (bx + 1 == bx_count) + (by == 0) + (by + 1 == by_count);
+    forEachNeighbour(b, bx_count, by_count, [&](int nb) {
+      if (!around_.insertNew(nb)) return;
+      ++boundary;
+      const BlockInfo& i = info_[nb];
+      if (!i.valid || !i.planar) return;
+      if (std::abs(normal.dot(i.centroid) + d) > params_.merge_distance + 3.0 * std::sqrt(i.centroid_variance)) return;
+      if (std::abs(i.normal.dot(normal)) < crease_cosine) return;
+      extended.push_back(nb);
+    });
+  }
+  const size_t continuing = extended.size() - blocks.size();
+  if (2 * continuing < boundary) return false;
+  return normalsTurn(extended, normal) || centroidsBend(extended, normal, d);
+}
+
 bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
 {
   // Mean normal of each half (split across either in-plane axis), from the blocks whose own

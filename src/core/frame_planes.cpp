@@ -560,6 +560,7 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
     return CandidateVerdict::kCurvedPatches;
   if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
     return CandidateVerdict::kCentroidsOffPlane;
+  if (grower.continuesAndBends(region.blocks, region.normal, region.d)) return CandidateVerdict::kCurvedPatches;
   // One patch left has passed this very test (the same blocks in the same order) just above.
   if (flat_patches > 1 && !tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
     return CandidateVerdict::kHalvesDisagree;

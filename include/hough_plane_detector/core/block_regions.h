@@ -30,6 +30,10 @@ constexpr double kMaxPlaneSag = 0.001;
 // How far a real face may depart from its plane: cardboard faces bow, panels warp (osd-learn's
 // box faces by 2-5 mm over 15 cm, one face grown as two regions 5 mm apart).
 constexpr double kSurfaceWarp = 0.005;
+// Neighbouring surfaces meeting at more than this (rad, 29 deg) are two faces (a box's edge,
+// a wall's corner, an open door); a gentler turn between a region and the blocks around it
+// may be one surface curving on (a ball, a pillar) and is tested as such (continuesAndBends).
+constexpr double kCreaseAngle = 0.5;
 
 // One block of the last frame, camera frame, with the noise limits the tests use.
 struct BlockInfo
@@ -211,6 +215,13 @@ public:
   // True when the blocks' own normals turn across the region, significantly beyond their
   // measured scatter and by more than a plane's curvature and sag may be (a pillar's or can's side).
   bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
+  // True when the region did not end where its surface does and that surface bends: half or more
+  // of the blocks around it (the image's edge counted as a boundary) continue it (flat, within
+  // merge_distance and their noise of its plane, turned less than kCreaseAngle from it), and
+  // with them the blocks turn or bend (normalsTurn, centroidsBend). A facet of a ball or a
+  // pillar passes those tests alone when correlated depth noise leaves its blocks' normals
+  // precise enough to stop the growing at the curve while its sag hides in the noise.
+  bool continuesAndBends(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
   // Weighted least-squares plane of the blocks' centroids; false when they fix no plane.
   bool fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const;
   // The same over the blocks' interior (those whose four neighbours are among them) when it
@@ -229,6 +240,7 @@ private:
   const std::vector<BlockInfo>& info_;
   const DetectorParams& params_;
   BlockMarks reached_;           // of sweep
+  mutable BlockMarks around_;    // of continuesAndBends
   BlockComponents components_;  // of seedComponents
 };
 
