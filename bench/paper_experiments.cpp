@@ -381,8 +381,10 @@ RandomSceneExperiment runRandomScenes(bool quick)
   // no ablations. list_room: the room gets its own row (the held-out seeds at their own C).
   // rooms: where the defaults' counts in this room go, if anywhere.
   // denser > 1: the same circle in `denser` times the frames, scored at the same viewpoints.
+  // correlation_px > 0: the noise a spatially correlated field (KinectNoise), as real frames'.
   auto runSeed = [&](uint32_t seed, std::vector<MethodStats>& set, bool list_room, double noise_override,
-                     bool defaults_only, std::vector<RoomCounts>* rooms, int denser = 1) {
+                     bool defaults_only, std::vector<RoomCounts>* rooms, int denser = 1,
+                     double correlation_px = 0.0) {
     RandomScene room = makeRandomScene(seed, frames * denser);
     if (noise_override > 0.0) room.noise = noise_override;
     const size_t used = defaults_only ? 1 : variants.size();
@@ -397,6 +399,7 @@ RandomSceneExperiment runRandomScenes(bool quick)
     std::vector<MethodStats> stats(used);
     KinectNoise noise;
     noise.coefficient = room.noise;
+    noise.correlation_px = correlation_px;
     const TourScoring scoring = roomTourScoring(denser);
     for (int f = 0; f < frames * denser; ++f)
     {
@@ -455,6 +458,19 @@ RandomSceneExperiment runRandomScenes(bool quick)
   runDenser(kSecondHeldOutSeeds, result.second_held_out_seeds);
   runDenser(kThirdHeldOutSeeds, result.third_held_out_seeds);
   result.held_out_at_c1_denser = denser.front();
+  // The three lists at C = 1 again with the noise correlated over kCorrelatedNoisePx pixels.
+  std::vector<MethodStats> correlated(1);
+  auto runCorrelated = [&](const std::vector<uint32_t>& seeds, size_t count) {
+    for (size_t i = 0; i < count; ++i)
+    {
+      std::fprintf(stderr, "  held-out seed %u, correlated noise\n", seeds[i]);
+      runSeed(seeds[i], correlated, false, 1.0, true, nullptr, 1, kCorrelatedNoisePx);
+    }
+  };
+  runCorrelated(kHeldOutSeeds, result.held_out_seeds);
+  runCorrelated(kSecondHeldOutSeeds, result.second_held_out_seeds);
+  runCorrelated(kThirdHeldOutSeeds, result.third_held_out_seeds);
+  result.held_out_at_c1_correlated = correlated.front();
   return result;
 }
 

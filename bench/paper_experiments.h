@@ -34,6 +34,9 @@ struct TourScoring
 // warm-up; a tour of the same circle in `denser` times the frames is scored at the same viewpoints.
 inline TourScoring roomTourScoring(int denser = 1) { return {kWarmupFrames * denser, 3 * denser}; }
 constexpr int kDenserTourFactor = 2;  // make evaluate's reported row of denser held-out tours
+// make evaluate's reported row with spatially correlated noise: the field of KinectNoise
+// smoothed over this many pixels, with its default shares (real frames' structure, README).
+constexpr double kCorrelatedNoisePx = 8.0;
 constexpr int kResolutionCount = 3;
 extern const int kResolutions[kResolutionCount];  // Fig. 7's Hough resolutions
 
@@ -167,6 +170,8 @@ struct RandomSceneExperiment
   MethodStats second_held_out, second_held_out_at_c1, third_held_out, third_held_out_at_c1;
   // All three lists at C = 1 toured in twice the frames, scored at the same viewpoints (reported).
   MethodStats held_out_at_c1_denser;
+  // All three lists at C = 1 with spatially correlated noise (kCorrelatedNoisePx; reported).
+  MethodStats held_out_at_c1_correlated;
   size_t held_out_seeds = 0, second_held_out_seeds = 0, third_held_out_seeds = 0, tuning_seeds = 0;
   std::vector<HeldOutRoom> rooms;              // the held-out seeds one by one
   // The defaults' counts in each room of all three held-out lists, at its own C and at C = 1:
