@@ -444,33 +444,24 @@ RandomSceneExperiment runRandomScenes(bool quick)
           result.second_held_out_at_c1);
   runList("third", kThirdHeldOutSeeds, result.third_held_out_seeds, result.third_held_out,
           result.third_held_out_at_c1);
-  // The three lists at C = 1 again, toured in kDenserTourFactor times the frames: the stream of a
-  // faster camera.
-  std::vector<MethodStats> denser(1);
-  auto runDenser = [&](const std::vector<uint32_t>& seeds, size_t count) {
-    for (size_t i = 0; i < count; ++i)
-    {
-      std::fprintf(stderr, "  held-out seed %u, %d frames\n", seeds[i], kDenserTourFactor * frames);
-      runSeed(seeds[i], denser, false, 1.0, true, nullptr, kDenserTourFactor);
-    }
+  // The three lists at C = 1 again, the defaults only, with one condition changed (reported rows).
+  auto runAllLists = [&](const char* condition, int denser, double correlation_px) {
+    std::vector<MethodStats> pooled(1);
+    const std::pair<const std::vector<uint32_t>*, size_t> lists[] = {{&kHeldOutSeeds, result.held_out_seeds},
+                                                                     {&kSecondHeldOutSeeds, result.second_held_out_seeds},
+                                                                     {&kThirdHeldOutSeeds, result.third_held_out_seeds}};
+    for (const auto& [seeds, count] : lists)
+      for (size_t i = 0; i < count; ++i)
+      {
+        std::fprintf(stderr, "  held-out seed %u, %s\n", (*seeds)[i], condition);
+        runSeed((*seeds)[i], pooled, false, 1.0, true, nullptr, denser, correlation_px);
+      }
+    return pooled.front();
   };
-  runDenser(kHeldOutSeeds, result.held_out_seeds);
-  runDenser(kSecondHeldOutSeeds, result.second_held_out_seeds);
-  runDenser(kThirdHeldOutSeeds, result.third_held_out_seeds);
-  result.held_out_at_c1_denser = denser.front();
-  // The three lists at C = 1 again with the noise correlated over kCorrelatedNoisePx pixels.
-  std::vector<MethodStats> correlated(1);
-  auto runCorrelated = [&](const std::vector<uint32_t>& seeds, size_t count) {
-    for (size_t i = 0; i < count; ++i)
-    {
-      std::fprintf(stderr, "  held-out seed %u, correlated noise\n", seeds[i]);
-      runSeed(seeds[i], correlated, false, 1.0, true, nullptr, 1, kCorrelatedNoisePx);
-    }
-  };
-  runCorrelated(kHeldOutSeeds, result.held_out_seeds);
-  runCorrelated(kSecondHeldOutSeeds, result.second_held_out_seeds);
-  runCorrelated(kThirdHeldOutSeeds, result.third_held_out_seeds);
-  result.held_out_at_c1_correlated = correlated.front();
+  // Toured in kDenserTourFactor times the frames: the stream of a faster camera.
+  result.held_out_at_c1_denser = runAllLists("denser tour", kDenserTourFactor, 0.0);
+  // With the noise correlated over kCorrelatedNoisePx pixels, as real frames'.
+  result.held_out_at_c1_correlated = runAllLists("correlated noise", 1, kCorrelatedNoisePx);
   return result;
 }
 
