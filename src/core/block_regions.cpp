@@ -271,8 +271,8 @@ bool BlockRegionGrower::continuesAndBends(const std::vector<int>& blocks, const 
   const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
   around_.clear(info_.size());
   for (int b : blocks) around_.insert(b);
-  std::vector<int> extended = blocks;
-  size_t boundary = 0;  // the blocks around it and its sides on the image's edge
+  std::vector<int> continuing;  // the blocks around it that continue its surface
+  size_t boundary = 0;          // the blocks around it and its sides on the image's edge
   const double crease_cosine = std::cos(kCreaseAngle);
   for (int b : blocks)
   {
@@ -286,11 +286,13 @@ bool BlockRegionGrower::continuesAndBends(const std::vector<int>& blocks, const 
       if (!i.valid || !i.planar) return;
       if (std::abs(normal.dot(i.centroid) + d) > params_.merge_distance + 3.0 * std::sqrt(i.centroid_variance)) return;
       if (std::abs(i.normal.dot(normal)) < crease_cosine) return;
-      extended.push_back(nb);
+      continuing.push_back(nb);
     });
   }
-  const size_t continuing = extended.size() - blocks.size();
-  if (2 * continuing < boundary) return false;
+  if (2 * continuing.size() < boundary) return false;
+  // Only a region that passes the share is copied: most (a floor's thousands of blocks) do not.
+  std::vector<int> extended = blocks;
+  extended.insert(extended.end(), continuing.begin(), continuing.end());
   return normalsTurn(extended, normal) || centroidsBend(extended, normal, d);
 }
 
