@@ -640,13 +640,6 @@ bool FramePlaneFitter::snapToKnownDirection(Eigen::Vector3d& normal, double& d, 
   const Eigen::Vector3d* known_normal =
       knownNormalFor(normal, frame_.camera_to_world * piece.mean(), map_planes, planes, &on_known_plane);
   if (!known_normal) return false;
-  // Without the world's up another surface's direction is parallel only by chance (a box top
-  // tilted 2-3 deg on a table, boxes at any yaw): a grown region whose own normal is precise at
-  // first sight is a complete measurement by itself and keeps it; the known direction orients
-  // only a piece its points orient less well. Its own surface re-measured still snaps.
-  if (!params_.world_z_up && params_.region_growing && !on_known_plane &&
-      kFirstSightSigmas * tests_.normalUncertainty(blocks) <= params_.merge_angle)
-    return false;
   const Eigen::Vector3d known = known_normal->dot(normal) >= 0.0 ? *known_normal : Eigen::Vector3d(-*known_normal);
   const Eigen::Vector3d n_cam = frame_.normalInCamera(known);
   // The offset most points agree on (a median: the leaning blocks are outliers), then the

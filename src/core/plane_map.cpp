@@ -461,6 +461,10 @@ const char* toString(FirstSight first_sight)
 
 namespace
 {
+// Two measurements of one surface differ by sqrt(2) sigma; a tolerance holds at 2 sigma of that
+// difference.
+constexpr double kFirstSightSigmas = 2.0 * M_SQRT2;
+
 // The offset is judged where the surface was measured, at its points: a far face's small tilt
 // error moves its offset at the world origin, not the surface shown.
 bool offsetPreciseAtFirstSight(const FramePlane& measured, double merge_distance)

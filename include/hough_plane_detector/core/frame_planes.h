@@ -3,7 +3,6 @@
 // the planarity tests pass; a plane a few degrees off a known one may take its normal.
 #pragma once
 
-#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,10 +16,6 @@
 
 namespace hough_plane_detector
 {
-
-// Two measurements of one surface differ by sqrt(2) sigma; a tolerance holds at 2 sigma of that
-// difference. A normal whose sigma times this is within merge_angle is precise at first sight.
-constexpr double kFirstSightSigmas = 2.0 * M_SQRT2;
 
 // What became of a local Hough peak of the last frame: why a plane in view was not detected.
 enum class CandidateVerdict
@@ -119,8 +114,7 @@ public:
   // on that parallel plane within their noise and the likelihood-ratio test allows (and, with
   // the world's up unknown and another surface's normal, a grown region's own scatter too:
   // NormalExplanation::interior_within_own_scatter, as acceptsKnownNormal asks with up known
-  // of normals off the vertical; and a grown region whose own normal is precise at first sight
-  // keeps it). True if it did; then `measured_by`, when given, holds the
+  // of normals off the vertical). True if it did; then `measured_by`, when given, holds the
   // blocks on that plane that measured its offset. A region `seen_edge_on` is judged by the
   // share of its blocks' depth noise along the known normal (the ray's sine of it).
   bool snapToKnownDirection(Eigen::Vector3d& normal, double& d, const std::vector<int>& blocks,
