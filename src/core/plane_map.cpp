@@ -423,6 +423,11 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // with it. Near a known plane it may be that plane measured badly, and waits for a second
   // frame; not near one this frame's measurements just replaced.
   const bool fits = plane.fits_its_blocks || plane.level_strip;
+  if (!fits && partOfMeasuredSurface(plane, frame_planes))
+  {
+    first_sight = FirstSight::kPartOfMeasuredSurface;
+    return 0.0f;
+  }
   if (!fits)
     first_sight = plane.blocks.empty() ? FirstSight::kWithoutBlocks : FirstSight::kNotFittingItsBlocks;
   else if (!preciseAtFirstSight(plane, frame_planes))
@@ -443,6 +448,8 @@ const char* toString(FirstSight first_sight)
       return "a map plane's";
     case FirstSight::kMixesSurfaces:
       return "mixes surfaces";
+    case FirstSight::kPartOfMeasuredSurface:
+      return "part of a surface the frame measured";
     case FirstSight::kTooSmall:
       return "too small to report at first sight";
     case FirstSight::kComplete:
@@ -486,6 +493,24 @@ bool PlaneMap::preciseAtFirstSight(const FramePlane& measured, const std::vector
   if (preciseAtFirstSight(measured)) return true;
   return offsetPreciseAtFirstSight(measured, params_.merge_distance) &&
          kFirstSightSigmas * sharedDirectionSigma(measured, frame_planes) <= params_.merge_angle;
+}
+
+bool PlaneMap::partOfMeasuredSurface(const FramePlane& region, const std::vector<FramePlane>& frame_planes) const
+{
+  // Two surfaces meet only along their edges, so a face of its own lies off another's plane by
+  // half its extent times the sine of their angle. A region centred on a surface this frame
+  // measured, whose blocks do not fit one plane, is that surface bent where the sensor bends
+  // it (a table's image corner 0.6 m from a structured-light camera, 0.1-0.17 rad off and
+  // 3-5 mm from the table at its centroid in osd-learn) or a part of it with a stray rim.
+  // One within the merge tolerances votes for that surface's plane (a snapped rest of a face).
+  if (region.blocks.empty()) return false;
+  return std::any_of(frame_planes.begin(), frame_planes.end(), [&](const FramePlane& surface) {
+    return &surface != &region && surface.fits_its_blocks && surface.support > region.support &&
+           std::abs(surface.normal.dot(region.centroid) + surface.d) <= kSurfaceWarp &&
+           unsignedAngle(surface.normal, region.normal) < kCreaseAngle &&
+           !withinMergeTolerances(surface.normal, surface.d, region.normal, region.d, params_.merge_angle,
+                                  params_.merge_distance);
+  });
 }
 
 double PlaneMap::sharedDirectionSigma(const FramePlane& snapped, const std::vector<FramePlane>& frame_planes) const

@@ -49,6 +49,7 @@ enum class FirstSight
 {
   kKnownPlane,           // on a map plane within the merge tolerances: weight 1
   kMixesSurfaces,        // its blocks lie off it beyond their noise: weight 0
+  kPartOfMeasuredSurface,  // does not fit its blocks, centred on a larger surface: weight 0
   kTooSmall,             // too few points for the curvature tests: weight 1
   kComplete,             // fits its blocks, precise, no map plane near: weight 2
   kWithoutBlocks,        // by support alone (1 to 2), since: measured without blocks to test
@@ -131,6 +132,10 @@ private:
   // The same, with a snapped plane's normal judged by every new surface of the frame that took
   // the same known direction (sharedDirectionSigma): a staircase's risers, a shelf's boards.
   bool preciseAtFirstSight(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const;
+  // True when `region`, which does not fit its blocks, is centred on the plane of a larger
+  // region of this frame that does (within kSurfaceWarp) and turned less than kCreaseAngle
+  // but beyond the merge tolerances from it: a part of that surface, not a surface of its own.
+  bool partOfMeasuredSurface(const FramePlane& region, const std::vector<FramePlane>& frame_planes) const;
   // The standard error (rad) of the direction that the snapped new planes of `frame_planes`
   // sharing `snapped`'s known normal measure together: their own normals pooled by their
   // information, when they agree with that normal and with each other (chi^2, p = 0.01).
