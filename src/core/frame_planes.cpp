@@ -556,7 +556,9 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
     return CandidateVerdict::kCurvedPatches;
   if (!grower.fit(region.blocks, region.normal, region.d)) return CandidateVerdict::kTooFewPoints;
   if (grower.seenEdgeOn(region.blocks, region.normal)) return CandidateVerdict::kEdgeOn;
-  if (grower.normalsTurn(region.blocks, region.normal) || grower.centroidsBend(region.blocks, region.normal, region.d))
+  const double max_sag = grower.maxPlaneSag(region.blocks);
+  if (grower.normalsTurn(region.blocks, region.normal, max_sag) ||
+      grower.centroidsBend(region.blocks, region.normal, region.d, max_sag))
     return CandidateVerdict::kCurvedPatches;
   if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
     return CandidateVerdict::kCentroidsOffPlane;
