@@ -74,20 +74,19 @@ TEST(BlockRegions, ThePillarsCentroidsBendAndTheWallsDoNot)
   Eigen::Vector3d normal;
   double d;
   ASSERT_TRUE(grower.fit(pillar, normal, d));
-  EXPECT_TRUE(grower.centroidsBend(pillar, normal, d, grower.maxPlaneSag(pillar)));
+  EXPECT_TRUE(grower.centroidsBend(pillar, normal, d));
   ASSERT_TRUE(grower.fit(wall, normal, d));
-  EXPECT_FALSE(grower.centroidsBend(wall, normal, d, grower.maxPlaneSag(wall)));
-  EXPECT_FALSE(grower.normalsTurn(wall, normal, grower.maxPlaneSag(wall)));
+  EXPECT_FALSE(grower.centroidsBend(wall, normal, d));
+  EXPECT_FALSE(grower.normalsTurn(wall, normal));
 }
 
 namespace
 {
 // Blocks of `spacing` (1 cm) on z = depth + curvature x^2 / 2 (camera frame) covering width x
 // height metres, each centroid known to model_sigma (0.2 mm) and each normal to 0.01 rad: the
-// bend is far beyond noise. With scatter > 0 the centroids are moved by that much Gaussian noise;
-// quantization_step is the sensor's depth step there (0: none, as a time-of-flight camera).
+// bend is far beyond noise. With scatter > 0 the centroids are moved by that much Gaussian noise.
 std::vector<BlockInfo> bentPatch(double curvature, double width, double height, double depth, double spacing = 0.01,
-                                 double model_sigma = 0.0002, double scatter = 0.0, double quantization_step = 0.0)
+                                 double model_sigma = 0.0002, double scatter = 0.0)
 {
   std::mt19937 random(7);
   std::normal_distribution<double> noise(0.0, 1.0);
@@ -101,7 +100,6 @@ std::vector<BlockInfo> bentPatch(double curvature, double width, double height, 
       info.centroid_variance = model_sigma * model_sigma;
       info.normal = Eigen::Vector3d(curvature * x, 0.0, -1.0).normalized();
       info.normal_tolerance = 0.01;
-      info.quantization_step = quantization_step;
       blocks.push_back(info);
     }
   return blocks;
@@ -116,8 +114,7 @@ bool curved(const std::vector<BlockInfo>& info, bool by_normals)
   double mean_depth = 0.0;
   for (const BlockInfo& i : info) mean_depth += i.centroid.z() / info.size();
   const Eigen::Vector3d normal(0.0, 0.0, -1.0);
-  const double max_sag = grower.maxPlaneSag(blocks);
-  return by_normals ? grower.normalsTurn(blocks, normal, max_sag) : grower.centroidsBend(blocks, normal, mean_depth, max_sag);
+  return by_normals ? grower.normalsTurn(blocks, normal) : grower.centroidsBend(blocks, normal, mean_depth);
 }
 }  // namespace
 
@@ -131,24 +128,6 @@ TEST(BlockRegions, ABendThatMovesNoPointAMillimetreIsStillAPlane)
     EXPECT_TRUE(curved(bentPatch(3.0, 0.20, 0.05, 0.7), by_normals)) << by_normals;
     EXPECT_TRUE(curved(bentPatch(1.0 / 0.033, 0.03, 0.08, 0.7), by_normals)) << by_normals;
     EXPECT_FALSE(curved(bentPatch(0.0, 0.20, 0.05, 0.7), by_normals)) << by_normals;
-  }
-}
-
-TEST(BlockRegions, ABendShallowerThanTheSensorsDepthStepIsStillAPlane)
-{
-  // A box top 0.9 m from a Kinect doming at 6 /m over 5 cm sags 1.9 mm: beyond kMaxPlaneSag, but
-  // within the 2.3 mm disparity step there, which a real face's bow and the sensor's own error
-  // both reach. Without steps (a time-of-flight camera) it is curved; so is a can's side
-  // (3.4 mm over 3 cm) at that step, and a 15 mm bend however coarse the steps (kSurfaceWarp).
-  const double kinect_step_at_0_9_m = 0.9 * 0.9 / (580.0 * 0.075 * 8.0);
-  for (bool by_normals : {false, true})
-  {
-    EXPECT_FALSE(curved(bentPatch(6.0, 0.05, 0.05, 0.9, 0.01, 0.0002, 0.0, kinect_step_at_0_9_m), by_normals))
-        << by_normals;
-    EXPECT_TRUE(curved(bentPatch(6.0, 0.05, 0.05, 0.9, 0.01, 0.0002, 0.0, 0.0), by_normals)) << by_normals;
-    EXPECT_TRUE(curved(bentPatch(1.0 / 0.033, 0.03, 0.08, 0.9, 0.01, 0.0002, 0.0, kinect_step_at_0_9_m), by_normals))
-        << by_normals;
-    EXPECT_TRUE(curved(bentPatch(3.0, 0.20, 0.05, 0.9, 0.01, 0.0002, 0.0, 0.03), by_normals)) << by_normals;
   }
 }
 

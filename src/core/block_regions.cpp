@@ -210,8 +210,7 @@ bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::
   return tested_points < params_.min_support;
 }
 
-bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d,
-                                      double max_sag) const
+bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const
 {
   if (blocks.size() < 12) return false;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -247,7 +246,7 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
   const double drop = chi2_plane - chi2_quadric, dof = static_cast<double>(blocks.size()) - 6.0;
   const bool beyond_model = drop > kChi2DropThreeDof;
   if (!beyond_model && !(drop / 3.0 > lackOfFitCritical(dof) * chi2_quadric / dof)) return false;
-  const double sag_bound = beyond_model ? max_sag : kSurfaceWarp;
+  const double max_sag = beyond_model ? kMaxPlaneSag : kSurfaceWarp;
   Eigen::Matrix2d hessian;
   hessian << 2.0 * quadric(3), quadric(4), quadric(4), 2.0 * quadric(5);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> curvatures;
@@ -261,7 +260,7 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
     double variance = 0.0;
     for (int b : blocks) variance += std::pow(axis.dot(info_[b].centroid - mean), 2);
     variance /= blocks.size();
-    if (curvature * 12.0 * variance / 8.0 > sag_bound) return true;
+    if (curvature * 12.0 * variance / 8.0 > max_sag) return true;
   }
   return false;
 }
@@ -294,14 +293,10 @@ bool BlockRegionGrower::continuesAndBends(const std::vector<int>& blocks, const 
   // Only a region that passes the share is copied: most (a floor's thousands of blocks) do not.
   std::vector<int> extended = blocks;
   extended.insert(extended.end(), continuing.begin(), continuing.end());
-  // The sensor's depth step excuses a bend over the region alone, not over the surface around
-  // it: a box face's bow ends at its edges, a curved surface goes on (with the step there too,
-  // osd-learn gained tilted table corners and correlated Table 3 false planes).
-  return normalsTurn(extended, normal, kMaxPlaneSag) || centroidsBend(extended, normal, d, kMaxPlaneSag);
+  return normalsTurn(extended, normal) || centroidsBend(extended, normal, d);
 }
 
-bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal,
-                                    double max_sag) const
+bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
 {
   // Mean normal of each half (split across either in-plane axis), from the blocks whose own
   // normal is informative; their difference against its standard error from the scatter.
@@ -359,22 +354,10 @@ bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen:
     const double separation = (where[1] - where[0]).norm();
     // The halves' centres lie half the width apart, so the sag is tilt * separation / 2.
     if (tilt > 3.0 * std::sqrt(error_variance) && tilt > kMaxPlaneCurvature * separation &&
-        tilt * separation / 2.0 > max_sag)
+        tilt * separation / 2.0 > kMaxPlaneSag)
       return true;
   }
   return false;
-}
-
-double BlockRegionGrower::maxPlaneSag(const std::vector<int>& blocks) const
-{
-  // A structured-light sensor's depths come in disparity steps (1/8 px: 1.8 mm at 0.8 m, 5 mm
-  // at 1.3 m), and what it cannot calibrate away is of that order: a bend shallower than one
-  // step there may be the sensor's own (osd-learn's box faces bow by 1-2 mm over a few cm,
-  // 0.7-1.2 m away). A bend beyond kSurfaceWarp is no plane's at any depth.
-  if (blocks.empty()) return kMaxPlaneSag;
-  double step = 0.0;
-  for (int b : blocks) step += info_[b].quantization_step;
-  return std::clamp(step / static_cast<double>(blocks.size()), kMaxPlaneSag, kSurfaceWarp);
 }
 
 bool BlockRegionGrower::fit(const std::vector<int>& blocks, Eigen::Vector3d& normal, double& d) const

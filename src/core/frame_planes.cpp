@@ -556,9 +556,7 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
     return CandidateVerdict::kCurvedPatches;
   if (!grower.fit(region.blocks, region.normal, region.d)) return CandidateVerdict::kTooFewPoints;
   if (grower.seenEdgeOn(region.blocks, region.normal)) return CandidateVerdict::kEdgeOn;
-  const double max_sag = grower.maxPlaneSag(region.blocks);
-  if (grower.normalsTurn(region.blocks, region.normal, max_sag) ||
-      grower.centroidsBend(region.blocks, region.normal, region.d, max_sag))
+  if (grower.normalsTurn(region.blocks, region.normal) || grower.centroidsBend(region.blocks, region.normal, region.d))
     return CandidateVerdict::kCurvedPatches;
   if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
     return CandidateVerdict::kCentroidsOffPlane;

@@ -25,8 +25,7 @@ constexpr double kMaxPlaneCurvature = 2.0;
 // ...unless the bend moves no point of the region farther than this (m) from its plane: finer
 // than a depth sensor resolves (a Kinect's disparity step is 0.7 mm at 0.5 m), as a box lid
 // doming 1 mm over 5 cm at 0.7 m (curvature 3/m). A can of 3.3 cm radius passes only as a
-// strip under 1.6 cm wide. Where the sensor's depth step is coarser, one step is the bound
-// (BlockRegionGrower::maxPlaneSag).
+// strip under 1.6 cm wide.
 constexpr double kMaxPlaneSag = 0.001;
 // How far a real face may depart from its plane: cardboard faces bow, panels warp (osd-learn's
 // box faces by 2-5 mm over 15 cm, one face grown as two regions 5 mm apart).
@@ -210,16 +209,12 @@ public:
   // significantly better (p < 0.001: its chi^2 drop over 3 degrees of freedom against the
   // noise model, or as an F test against their own scatter about the quadric) and its larger
   // principal curvature exceeds what a plane may have (a pillar's, a ball's or a can's side)
-  // with a sag over the region's width beyond `max_sag` (beyond kSurfaceWarp when only the
+  // with a sag over the region's width beyond kMaxPlaneSag (beyond kSurfaceWarp when only the
   // F test finds the bend).
-  bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d, double max_sag) const;
+  bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
   // True when the blocks' own normals turn across the region, significantly beyond their
-  // measured scatter and by more than a plane's curvature and `max_sag` allow (a pillar's or
-  // can's side).
-  bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double max_sag) const;
-  // The deepest bend (m) a plane may show over these blocks: kMaxPlaneSag, or the sensor's depth
-  // step at their depth where that is coarser, never beyond kSurfaceWarp.
-  double maxPlaneSag(const std::vector<int>& blocks) const;
+  // measured scatter and by more than a plane's curvature and sag may be (a pillar's or can's side).
+  bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
   // True when the region did not end where its surface does and that surface bends: half or more
   // of the blocks around it (the image's edge counted as a boundary) continue it (flat, within
   // merge_distance and their noise of its plane, turned less than kCreaseAngle from it), and
