@@ -424,16 +424,14 @@ float PlaneMap::voteWeight(const FramePlane& plane, const std::vector<FramePlane
   // frame; not near one this frame's measurements just replaced.
   const bool fits = plane.fits_its_blocks || plane.level_strip;
   if (!fits && partOfMeasuredSurface(plane, frame_planes))
-  {
     first_sight = FirstSight::kPartOfMeasuredSurface;
-    return 0.0f;
-  }
-  if (!fits)
+  else if (!fits)
     first_sight = plane.blocks.empty() ? FirstSight::kWithoutBlocks : FirstSight::kNotFittingItsBlocks;
   else if (!preciseAtFirstSight(plane, frame_planes))
     first_sight = FirstSight::kImprecise;
   else
     first_sight = nearKnownPlane(plane, dropped) ? FirstSight::kNearKnownPlane : FirstSight::kComplete;
+  if (first_sight == FirstSight::kPartOfMeasuredSurface) return 0.0f;
   if (first_sight == FirstSight::kComplete) return 2.0f;
   const bool offset_only = plane.parallel && (plane.blocks.empty() || fits);
   const double bar = offset_only ? 0.25 * strong_support : strong_support;

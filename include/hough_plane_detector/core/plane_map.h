@@ -47,15 +47,15 @@ struct SnapTilts
 // complete measurement of a new surface (reported at first sight), or why it was not one.
 enum class FirstSight
 {
-  kKnownPlane,           // on a map plane within the merge tolerances: weight 1
-  kMixesSurfaces,        // its blocks lie off it beyond their noise: weight 0
+  kKnownPlane,             // on a map plane within the merge tolerances: weight 1
+  kMixesSurfaces,          // its blocks lie off it beyond their noise: weight 0
   kPartOfMeasuredSurface,  // does not fit its blocks, centred on a larger surface: weight 0
-  kTooSmall,             // too few points for the curvature tests: weight 1
-  kComplete,             // fits its blocks, precise, no map plane near: weight 2
-  kWithoutBlocks,        // by support alone (1 to 2), since: measured without blocks to test
-  kNotFittingItsBlocks,  //   ... its blocks do not pass the noise tests of a plane
-  kImprecise,            //   ... a second measurement could fall beyond the merge tolerances
-  kNearKnownPlane,       //   ... it may be a map plane near it measured badly
+  kTooSmall,               // too few points for the curvature tests: weight 1
+  kComplete,               // fits its blocks, precise, no map plane near: weight 2
+  kWithoutBlocks,          // by support alone (1 to 2), since: measured without blocks to test
+  kNotFittingItsBlocks,    //   ... its blocks do not pass the noise tests of a plane
+  kImprecise,              //   ... a second measurement could fall beyond the merge tolerances
+  kNearKnownPlane,         //   ... it may be a map plane near it measured badly
 };
 const char* toString(FirstSight first_sight);
 
