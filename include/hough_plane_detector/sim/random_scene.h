@@ -35,9 +35,9 @@ RandomScene makeRandomScene(uint32_t seed, int frames);
 // each before any run on it). Tuning (looking at results, changing the detector) uses
 // kTuningSeeds, kDevelopmentSeeds, a wider set whose misses were looked at one by one, and
 // kSecondDevelopmentSeeds (300-339, at C = 1) and kThirdDevelopmentSeeds (600-679, at each
-// room's C: false planes are rare events, and 40 rooms left their rate uncertain); seeds
-// 400-459 were looked at while the close-surface peaks were developed. None of those is
-// reported as held out.
+// room's C: false planes are rare events, and 40 rooms left their rate uncertain) and
+// kFourthDevelopmentSeeds (700-899, at C = 1); seeds 400-459 were looked at while the
+// close-surface peaks were developed. None of those is reported as held out.
 extern const std::vector<uint32_t> kHeldOutSeeds;
 extern const std::vector<uint32_t> kSecondHeldOutSeeds;
 extern const std::vector<uint32_t> kThirdHeldOutSeeds;
@@ -45,5 +45,6 @@ extern const std::vector<uint32_t> kTuningSeeds;
 extern const std::vector<uint32_t> kDevelopmentSeeds;
 extern const std::vector<uint32_t> kSecondDevelopmentSeeds;
 extern const std::vector<uint32_t> kThirdDevelopmentSeeds;
+extern const std::vector<uint32_t> kFourthDevelopmentSeeds;
 
 }  // namespace hough_plane_detector
