@@ -1048,6 +1048,22 @@ TEST(PlaneDetector, ALevelStripSnappedToTheFloorsNormalIsReportedAtFirstSight)
                    {651, 15, "box0_top"}});
 }
 
+// Development D rooms 732, 763, 809 and 754: a surface snapped onto a known direction its own
+// blocks orient only to 0.02-0.04 rad (a door or a box face given another face's normal, a
+// 0.33 m cylinder's strip given a wall's) makes a map plane off every true one. Its depths
+// confirm it in later frames as they would the true plane beside it, so before this rule it
+// was kept out of view for the rest of the tour (up to 13 scored frames). Such a snap votes
+// but does not vouch for one surface: the plane stays tentative and fades unless measured again.
+TEST(PlaneDetector, APlaneOnlyAnImpreciseSnapMeasuredIsNotKeptOutOfView)
+{
+  for (const auto& [seed, last_frame] :
+       {std::make_pair(732u, 15), std::make_pair(763u, 21), std::make_pair(809u, 9), std::make_pair(754u, 18)})
+  {
+    const RoomFrame frame = tourDevelopmentRoom(seed, last_frame, "floor", 1);
+    EXPECT_EQ(frame.false_planes, 0) << "room " << seed << " frame " << last_frame << frame.planes;
+  }
+}
+
 // Development rooms 633 (frame 3) and 674 (frame 9): a shelf board's top seen as a narrow
 // band, snapped to the floor's normal. Its own blocks orient it only to 0.02-0.025 rad, which
 // is too imprecise a first sight for a plane of its own normal; but a level snap's normal is

@@ -635,12 +635,21 @@ int PlaneMap::remeasuredPlane(const FramePlane& measured) const
   return match;
 }
 
-bool PlaneMap::remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes,
-                          bool as_one_surface) const
+bool PlaneMap::remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const
 {
-  for (const FramePlane& measured : frame_planes)
-    if ((!as_one_surface || measured.measuresOneSurface()) && samePlane(plane, measured)) return true;
-  return false;
+  return std::any_of(frame_planes.begin(), frame_planes.end(),
+                     [&](const FramePlane& measured) { return samePlane(plane, measured); });
+}
+
+bool PlaneMap::vouchesForOneSurface(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const
+{
+  // A snap whose own normal is too noisy to be reported at first sight measured an offset along
+  // a borrowed direction that its blocks could not check (a box face given another box's normal,
+  // a wide cylinder's strip a wall's): it votes, but does not make its plane one to keep out of
+  // view. Development D (seeds 700-899) kept such planes for the rest of a tour.
+  if (!measured.measuresOneSurface()) return false;
+  const bool snapped = measured.parallel && !measured.blocks.empty();
+  return !snapped || preciseAtFirstSight(measured, frame_planes);
 }
 
 void PlaneMap::matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp)
@@ -709,7 +718,10 @@ void PlaneMap::carryBeliefs()
 void PlaneMap::countOneSurfaceMeasurements(const std::vector<FramePlane>& frame_planes)
 {
   for (const DetectedPlane& plane : planes_)
-    if (remeasured(plane, frame_planes, true)) ++beliefs_[plane.id].one_surface_measurements;
+    if (std::any_of(frame_planes.begin(), frame_planes.end(), [&](const FramePlane& measured) {
+          return samePlane(plane, measured) && vouchesForOneSurface(measured, frame_planes);
+        }))
+      ++beliefs_[plane.id].one_surface_measurements;
 }
 
 void PlaneMap::observe(const std::vector<int>& support, const std::vector<int>& block_labels, const FrameData& frame,

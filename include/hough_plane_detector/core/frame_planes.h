@@ -83,7 +83,8 @@ struct FramePlane
 
   // A measurement of one surface: a region that fits its blocks, or a plane measured without
   // blocks (the parallel search's, tested cluster by cluster; the paper's windows). The map keeps
-  // a plane out of view only once such a measurement has supported it (PlaneBelief).
+  // a plane out of view only once such a measurement has supported it (PlaneBelief), a snapped
+  // one only when precise (PlaneMap::vouchesForOneSurface).
   bool measuresOneSurface() const { return fits_its_blocks || blocks.empty(); }
 };
 

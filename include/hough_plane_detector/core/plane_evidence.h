@@ -52,7 +52,7 @@ struct PlaneBelief
   double log_odds = kStart;
   int64_t confirmations = 0;    // frames that confirmed it
   int64_t contradictions = 0;   // frames that contradicted it
-  // Frames that measured it as one surface (FramePlane::measuresOneSurface). Depths within
+  // Frames that measured it as one surface (PlaneMap::vouchesForOneSurface). Depths within
   // 3 sigma + 2 cm confirm a plane fitted through two surfaces too (a box's side and the face of
   // the box stacked on it), in every frame that sees them from about the same view; only a
   // measurement whose blocks lie on the plane within their noise tells one surface from such a mix.

@@ -151,10 +151,12 @@ private:
   // The map plane (index of planes_) a frame's plane re-measures: the closest within the merge
   // tolerances (samePlane), or -1 when none is.
   int remeasuredPlane(const FramePlane& measured) const;
-  // True when one of this frame's planes (those that measure one surface, if asked) lies on
-  // `plane` within the merge tolerances.
-  bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes,
-                  bool as_one_surface = false) const;
+  // True when one of this frame's planes lies on `plane` within the merge tolerances.
+  bool remeasured(const DetectedPlane& plane, const std::vector<FramePlane>& frame_planes) const;
+  // True when `measured` tells that one surface lies on its plane (PlaneBelief's
+  // one_surface_measurements): it measures one surface (FramePlane::measuresOneSurface) and, if
+  // snapped, its blocks could check the direction it took (preciseAtFirstSight).
+  bool vouchesForOneSurface(const FramePlane& measured, const std::vector<FramePlane>& frame_planes) const;
   // Two surfaces closer than a peak window share one maximum: when this frame measured them
   // apart, or the map held them apart and depths confirmed them, the maximum's peak moves to
   // one of them and each other gets a peak at its own place (this frame's, else the map's).
@@ -174,7 +176,7 @@ private:
   void matchIds(const std::vector<HoughPeak>& peaks, const Eigen::Vector3d& camera_position, double stamp);
   // Beliefs follow the ids: new planes start afresh, planes that left the map take theirs along.
   void carryBeliefs();
-  // Each map plane that one of this frame's measurements of one surface supports (PlaneBelief).
+  // Each map plane that one of this frame's planes vouches for as one surface (PlaneBelief).
   void countOneSurfaceMeasurements(const std::vector<FramePlane>& frame_planes);
   // How fast extents fade per frame: with thinning as the Hough space does, by evidence never.
   float extentFade() const;
