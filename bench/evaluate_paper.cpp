@@ -413,7 +413,7 @@ void writeRandomScenes(const RandomSceneExperiment& e, Report& report)
                    "eq. 11 noise with C drawn from 0.5-2 (the detector's sensor_noise = max(1, C)). %d frames a room, "
                    "scored every 3rd from frame %d as Table 3. The held-out seeds (101-120) were written down before "
                    "any threshold was chosen on these rooms and are reported only; tuning looks at seeds 901-908, "
-                   "950-965 and 300-339 only. The rows without the parallel search, without the snap and with snaps judged by "
+                   "950-965, 300-339, 600-679 and 700-899 only. The rows without the parallel search, without the snap and with snaps judged by "
                    "the noise model alone (world_z_up 0: no F test of snaps off the vertical) show what each of those "
                    "rules adds. The row at C = 1 renders the same held-out rooms and paths at C = 1, the condition the "
                    "targets are stated at; the rows above it keep each room's own C. A second held-out list "
