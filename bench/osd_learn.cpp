@@ -49,10 +49,13 @@ bool matches(const Eigen::Vector3d& n, double d, const Entry& e, double* angle =
   return a <= kMatchAngle && dd <= kMatchDistance;
 }
 
-// Scores one frame's detections: found entries (with their errors), duplicates, unmatched.
+// Scores one frame's detections: found entries (with their errors), duplicates, unmatched;
+// `duplicate_of` receives, per detection, the entry it duplicates, else -1.
 void score(const std::vector<Entry>& entries, const std::vector<Eigen::Vector4d>& detections, OsdMethodResult& result,
-           std::vector<bool>* found_out = nullptr, std::vector<double>* angle_out = nullptr)
+           std::vector<bool>* found_out = nullptr, std::vector<double>* angle_out = nullptr,
+           std::vector<int>* duplicate_of = nullptr)
 {
+  if (duplicate_of) duplicate_of->assign(detections.size(), -1);
   std::vector<int> matched(entries.size(), 0);
   std::vector<double> best_angle(entries.size(), 1e9), best_d(entries.size(), 1e9);
   for (const Eigen::Vector4d& p : detections)
@@ -79,7 +82,11 @@ void score(const std::vector<Entry>& entries, const std::vector<Eigen::Vector4d>
       ++result.unmatched;
       continue;
     }
-    if (matched[best]++ > 0) ++result.duplicates;
+    if (matched[best]++ > 0)
+    {
+      ++result.duplicates;
+      if (duplicate_of) (*duplicate_of)[&p - detections.data()] = best;
+    }
     double a, dd;
     matches(n, d, entries[best], &a, &dd);
     if (a + dd < best_angle[best] + best_d[best])
@@ -235,6 +242,48 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
     fit.labelled_fit_angle = maskedPlaneNormal(cloud, ours, 3, labelled_normal) ? unsignedAngle(labelled_normal, e.normal)
                                                                                  : M_PI / 2;
     out.push_back(fit);
+  }
+}
+
+// Where the pixels of each of our duplicate planes lie: see OsdDuplicate.
+void describeDuplicates(const PlaneDetector& detector, const CloudView& view,
+                        const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::string& frame,
+                        const std::vector<Entry>& entries, const std::vector<int>& duplicate_of,
+                        std::vector<OsdDuplicate>& out)
+{
+  std::vector<int> labels;
+  for (size_t k = 0; k < duplicate_of.size(); ++k)
+  {
+    if (duplicate_of[k] < 0) continue;
+    if (labels.empty()) detector.labelPixels(view, labels);
+    const Entry& e = entries[duplicate_of[k]];
+    const DetectedPlane& plane = detector.planes()[k];  // the detections are the map's planes in order
+    OsdDuplicate duplicate;
+    duplicate.frame = frame;
+    duplicate.entry = e.name;
+    matches(plane.normal, plane.d, e, nullptr, &duplicate.offset);
+    double sum = 0.0, squares = 0.0;
+    std::map<uint32_t, int> by_object;
+    for (size_t i = 0; i < labels.size(); ++i)
+    {
+      const pcl::PointXYZRGBL& q = cloud.points[i];
+      if (labels[i] != plane.id || !std::isfinite(q.z)) continue;
+      const double distance = e.normal.dot(Eigen::Vector3d(q.x, q.y, q.z)) + e.d;
+      sum += distance;
+      squares += distance * distance;
+      ++by_object[q.label / 10];
+      ++duplicate.pixels;
+    }
+    if (duplicate.pixels > 0)
+    {
+      duplicate.mean_distance = sum / duplicate.pixels;
+      duplicate.rms = std::sqrt(std::max(0.0, squares / duplicate.pixels - duplicate.mean_distance * duplicate.mean_distance));
+      const auto most = std::max_element(by_object.begin(), by_object.end(),
+                                         [](const auto& a, const auto& b) { return a.second < b.second; });
+      duplicate.object = most->first == 0 ? "table" : "obj" + std::to_string(10 * most->first);
+      duplicate.object_share = static_cast<double>(most->second) / duplicate.pixels;
+    }
+    out.push_back(duplicate);
   }
 }
 
@@ -436,7 +485,9 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
       if (copy > 0) continue;
       single.ms.push_back(detector.lastTimings().total_ms);
       std::vector<double> our_angles;
-      score(entries, mapPlanes(detector), single, &found, &our_angles);
+      std::vector<int> duplicate_of;
+      score(entries, mapPlanes(detector), single, &found, &our_angles, &duplicate_of);
+      describeDuplicates(detector, view, cloud, name, entries, duplicate_of, results.duplicates);
       for (size_t i = 0; i < entries.size(); ++i)
         if (!found[i])
         {
@@ -521,6 +572,19 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
     md += line;
   }
   if (!results.rim_checks.empty()) md += "\n" + osdRimMarkdown(results);
+  if (!results.duplicates.empty())
+  {
+    md += "\nOur duplicates (one frame): a second plane of ours within the tolerance of an entry another of ours "
+          "matches better, and where the pixels it labels lie (distance from the entry's plane, + toward the camera):";
+    for (const OsdDuplicate& d : results.duplicates)
+    {
+      std::snprintf(line, sizeof(line), " %s %s, %.1f mm off it, %d pixels at %+.1f mm (RMS %.1f mm), %.0f %% on %s;",
+                    d.frame.c_str(), d.entry.c_str(), 1000.0 * d.offset, d.pixels, 1000.0 * d.mean_distance,
+                    1000.0 * d.rms, 100.0 * d.object_share, d.object.c_str());
+      md += line;
+    }
+    md += "\n";
+  }
   md += "\nOur misses (one frame), by what became of the nearest candidate:";
   for (const auto& [reason, count] : results.misses_by_reason) md += " " + reason + ": " + std::to_string(count) + ";";
   md += "\n\n| frame | entry | points | why | nearest candidate off by |\n|---|---|---|---|---|\n";

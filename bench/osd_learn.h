@@ -44,6 +44,20 @@ struct OsdMiss
   std::string nearest_offsets;  // that candidate's angle and offset from the entry ("" when none)
 };
 
+// A second plane of ours within the tolerance of an entry another of ours matches better (one
+// frame), and where the pixels we label with it lie: a surface of its own that is not
+// annotated (under 2000 points, within 3 cm of an entry) shows as such.
+struct OsdDuplicate
+{
+  std::string frame, entry;
+  double offset = 0.0;         // our plane's offset from the entry's (m)
+  int pixels = 0;              // its labelled pixels with a return
+  double mean_distance = 0.0;  // their signed distance from the entry's plane (m, + toward the camera)
+  double rms = 0.0;            // about that mean (m)
+  std::string object;          // the label under most of them: table, obj20, obj30, ...
+  double object_share = 0.0;
+};
+
 // A found entry's normal error (one frame), beside that of the least-squares plane of the
 // pixels our detector labels with the matching plane (inside the entry's box, 10 px margin):
 // a large first with a small second means the plane's points were right and its normal was
@@ -74,6 +88,7 @@ struct OsdResults
 {
   std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
   std::vector<OsdMiss> misses;           // ours, single frame
+  std::vector<OsdDuplicate> duplicates;  // ours, single frame
   std::map<std::string, int> misses_by_reason;
   std::vector<OsdFitError> fit_errors;   // ours, single frame, every found entry (when asked for)
   std::vector<std::string> pictures;     // segmented frames written (PNG paths)
