@@ -574,8 +574,8 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
   if (!results.rim_checks.empty()) md += "\n" + osdRimMarkdown(results);
   if (!results.duplicates.empty())
   {
-    md += "\nOur duplicates (one frame): a second plane of ours within the tolerance of an entry another of ours "
-          "matches better, and where the pixels it labels lie (distance from the entry's plane, + toward the camera):";
+    md += "\nOur duplicates (one frame): each plane of ours matching an entry an earlier one matches, and where "
+          "the pixels it labels lie (distance from the entry's plane, + toward the camera):";
     for (const OsdDuplicate& d : results.duplicates)
     {
       std::snprintf(line, sizeof(line), " %s %s, %.1f mm off it, %d pixels at %+.1f mm (RMS %.1f mm), %.0f %% on %s;",

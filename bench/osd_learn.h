@@ -44,8 +44,8 @@ struct OsdMiss
   std::string nearest_offsets;  // that candidate's angle and offset from the entry ("" when none)
 };
 
-// A second plane of ours within the tolerance of an entry another of ours matches better (one
-// frame), and where the pixels we label with it lie: a surface of its own that is not
+// A plane of ours counted as a duplicate (one frame: it matches an entry an earlier plane of
+// ours matches), and where the pixels we label with it lie: a surface of its own that is not
 // annotated (under 2000 points, within 3 cm of an entry) shows as such.
 struct OsdDuplicate
 {
