@@ -210,7 +210,8 @@ bool BlockRegionGrower::seenEdgeOn(const std::vector<int>& blocks, const Eigen::
   return tested_points < params_.min_support;
 }
 
-bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const
+bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d,
+                                      double max_sag) const
 {
   if (blocks.size() < 12) return false;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -246,7 +247,7 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
   const double drop = chi2_plane - chi2_quadric, dof = static_cast<double>(blocks.size()) - 6.0;
   const bool beyond_model = drop > kChi2DropThreeDof;
   if (!beyond_model && !(drop / 3.0 > lackOfFitCritical(dof) * chi2_quadric / dof)) return false;
-  const double max_sag = beyond_model ? kMaxPlaneSag : kSurfaceWarp;
+  const double sag_bar = beyond_model ? max_sag : std::max(max_sag, kSurfaceWarp);
   Eigen::Matrix2d hessian;
   hessian << 2.0 * quadric(3), quadric(4), quadric(4), 2.0 * quadric(5);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> curvatures;
@@ -260,35 +261,65 @@ bool BlockRegionGrower::centroidsBend(const std::vector<int>& blocks, const Eige
     double variance = 0.0;
     for (int b : blocks) variance += std::pow(axis.dot(info_[b].centroid - mean), 2);
     variance /= blocks.size();
-    if (curvature * 12.0 * variance / 8.0 > max_sag) return true;
+    if (curvature * 12.0 * variance / 8.0 > sag_bar) return true;
   }
   return false;
 }
 
-bool BlockRegionGrower::continuesAndBends(const std::vector<int>& blocks, const Eigen::Vector3d& normal,
-                                          double d) const
+size_t BlockRegionGrower::continuingBlocks(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d,
+                                          std::vector<int>& continuing, size_t* unoriented_on_plane,
+                                          size_t* image_edge_sides) const
 {
+  if (unoriented_on_plane) *unoriented_on_plane = 0;
+  if (image_edge_sides) *image_edge_sides = 0;
   const int bx_count = grid_.blocksX(), by_count = grid_.blocksY();
   around_.clear(info_.size());
   for (int b : blocks) around_.insert(b);
-  std::vector<int> continuing;  // the blocks around it that continue its surface
-  size_t boundary = 0;          // the blocks around it and its sides on the image's edge
+  continuing.clear();
+  size_t boundary = 0;  // the blocks around it and its sides on the image's edge
   const double crease_cosine = std::cos(kCreaseAngle);
   for (int b : blocks)
   {
     // Beyond the image's edge the surface is unknown: it counts as a boundary.
     const int bx = b % bx_count, by = b / bx_count;
-    boundary += (bx == 0) + (bx + 1 == bx_count) + (by == 0) + (by + 1 == by_count);
+    const int edge_sides = (bx == 0) + (bx + 1 == bx_count) + (by == 0) + (by + 1 == by_count);
+    boundary += edge_sides;
+    if (image_edge_sides) *image_edge_sides += edge_sides;
     forEachNeighbour(b, bx_count, by_count, [&](int nb) {
       if (!around_.insertNew(nb)) return;
       ++boundary;
       const BlockInfo& i = info_[nb];
       if (!i.valid || !i.planar) return;
       if (std::abs(normal.dot(i.centroid) + d) > params_.merge_distance + 3.0 * std::sqrt(i.centroid_variance)) return;
-      if (std::abs(i.normal.dot(normal)) < crease_cosine) return;
+      if (std::abs(i.normal.dot(normal)) < crease_cosine)
+      {
+        if (unoriented_on_plane && i.normal_tolerance >= M_PI / 2) ++*unoriented_on_plane;
+        return;
+      }
       continuing.push_back(nb);
     });
   }
+  return boundary;
+}
+
+bool BlockRegionGrower::endsWhereItsSurfaceDoes(const std::vector<int>& blocks, const Eigen::Vector3d& normal,
+                                                double d) const
+{
+  // Neither a block on its plane whose own normal is uninformative (its noise as thick as a good
+  // part of its width), which cannot show a crease, nor the image's edge, beyond which the
+  // surface is unknown, shows where the face ends.
+  std::vector<int> continuing;
+  size_t unoriented_on_plane = 0, image_edge_sides = 0;
+  const size_t boundary = continuingBlocks(blocks, normal, d, continuing, &unoriented_on_plane, &image_edge_sides);
+  return static_cast<double>(continuing.size() + unoriented_on_plane + image_edge_sides) <
+         kMaxContinuingShareOfAFace * static_cast<double>(boundary);
+}
+
+bool BlockRegionGrower::continuesAndBends(const std::vector<int>& blocks, const Eigen::Vector3d& normal,
+                                          double d) const
+{
+  std::vector<int> continuing;  // the blocks around it that continue its surface
+  const size_t boundary = continuingBlocks(blocks, normal, d, continuing);
   if (2 * continuing.size() < boundary) return false;
   // Only a region that passes the share is copied: most (a floor's thousands of blocks) do not.
   std::vector<int> extended = blocks;
@@ -296,7 +327,8 @@ bool BlockRegionGrower::continuesAndBends(const std::vector<int>& blocks, const 
   return normalsTurn(extended, normal) || centroidsBend(extended, normal, d);
 }
 
-bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const
+bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal,
+                                    double max_sag) const
 {
   // Mean normal of each half (split across either in-plane axis), from the blocks whose own
   // normal is informative; their difference against its standard error from the scatter.
@@ -354,7 +386,7 @@ bool BlockRegionGrower::normalsTurn(const std::vector<int>& blocks, const Eigen:
     const double separation = (where[1] - where[0]).norm();
     // The halves' centres lie half the width apart, so the sag is tilt * separation / 2.
     if (tilt > 3.0 * std::sqrt(error_variance) && tilt > kMaxPlaneCurvature * separation &&
-        tilt * separation / 2.0 > kMaxPlaneSag)
+        tilt * separation / 2.0 > max_sag)
       return true;
   }
   return false;

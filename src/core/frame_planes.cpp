@@ -550,19 +550,24 @@ CandidateVerdict FramePlaneFitter::testRegion(const BlockRegionGrower& grower, P
   // components kept.
   const double min_points = std::max(3, params_.min_support);
   if (region.points < min_points) return CandidateVerdict::kTooFewPoints;
+  // A region that ends where its surface does is a whole face, which may bow as real faces do
+  // (kSurfaceWarp); one that runs on is judged with its continuation (continuesAndBends).
+  const double max_sag =
+      grower.endsWhereItsSurfaceDoes(region.blocks, region.normal, region.d) ? kSurfaceWarp : kMaxPlaneSag;
   int flat_patches = 0;
-  if ((moments = tests_.keepFlatComponents(region.blocks, params_.merge_angle, 1, nullptr, &flat_patches)).count <
-      min_points)
+  if ((moments = tests_.keepFlatComponents(region.blocks, params_.merge_angle, 1, nullptr, &flat_patches, max_sag))
+          .count < min_points)
     return CandidateVerdict::kCurvedPatches;
   if (!grower.fit(region.blocks, region.normal, region.d)) return CandidateVerdict::kTooFewPoints;
   if (grower.seenEdgeOn(region.blocks, region.normal)) return CandidateVerdict::kEdgeOn;
-  if (grower.normalsTurn(region.blocks, region.normal) || grower.centroidsBend(region.blocks, region.normal, region.d))
+  if (grower.normalsTurn(region.blocks, region.normal, max_sag) ||
+      grower.centroidsBend(region.blocks, region.normal, region.d, max_sag))
     return CandidateVerdict::kCurvedPatches;
   if (!tests_.isPlanarFit(tests_.weightedMoments(region.blocks), region.blocks))
     return CandidateVerdict::kCentroidsOffPlane;
   if (grower.continuesAndBends(region.blocks, region.normal, region.d)) return CandidateVerdict::kCurvedPatches;
   // One patch left has passed this very test (the same blocks in the same order) just above.
-  if (flat_patches > 1 && !tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle))
+  if (flat_patches > 1 && !tests_.halvesAgree(region.blocks, 0, region.blocks.size(), params_.merge_angle, max_sag))
     return CandidateVerdict::kHalvesDisagree;
   return CandidateVerdict::kAccepted;
 }

@@ -38,7 +38,8 @@ bool PlanarityTests::isPlanarFit(const PointMoments& moments, const std::vector<
 }
 
 
-bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const
+bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle,
+                                 double max_sag) const
 {
   // A curved strip fits a plane within the noise, but its two halves tilt apart.
   // Each block's centroid moments, centroid and variance, read once for both axes.
@@ -97,7 +98,8 @@ bool PlanarityTests::halvesAgree(const std::vector<int>& blocks, size_t begin, s
     if (!params_.region_growing) return false;
     const double separation = (halves[1].mean() - halves[0].mean()).norm();
     const bool bends = tilt > 2.0 * max_angle || tilt > kMaxPlaneCurvature * separation;
-    if (tilt > 3.0 * std::sqrt(tilt_variance) && bends) return false;
+    // The halves' centres lie half the width apart, so the sag is tilt * separation / 2.
+    if (tilt > 3.0 * std::sqrt(tilt_variance) && bends && tilt * separation / 2.0 > max_sag) return false;
   }
   return true;
 }
@@ -185,7 +187,7 @@ PointMoments PlanarityTests::weightedMoments(const std::vector<int>& blocks) con
 
 PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
                                                const std::function<bool(const std::vector<int>&)>& also,
-                                               int* kept_count) const
+                                               int* kept_count, double max_sag) const
 {
   if (kept_count) *kept_count = 0;
   // Two pillars can share a tangent plane: each connected patch of the support must be flat
@@ -201,7 +203,7 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
       y_min = std::min(y_min, b / bx_count), y_max = std::max(y_max, b / bx_count);
     }
     const bool wide_enough = x_max - x_min + 1 >= min_span && y_max - y_min + 1 >= min_span;
-    if (component.size() >= kMinComponentBlocks && wide_enough && halvesAgree(component, 0, component.size(), max_angle) &&
+    if (component.size() >= kMinComponentBlocks && wide_enough && halvesAgree(component, 0, component.size(), max_angle, max_sag) &&
         (!also || also(component)))
     {
       kept.insert(kept.end(), component.begin(), component.end());

@@ -30,6 +30,11 @@ constexpr double kMaxPlaneSag = 0.001;
 // How far a real face may depart from its plane: cardboard faces bow, panels warp (osd-learn's
 // box faces by 2-5 mm over 15 cm, one face grown as two regions 5 mm apart).
 constexpr double kSurfaceWarp = 0.005;
+// A region ends where its surface does (endsWhereItsSurfaceDoes) when under this share of what
+// lies around it continues it: most of its rim is creases, depth jumps or no returns. osd-learn's
+// box tops seen over their front have 0.23-0.36 of their rim continuing; a cylinder's facet between
+// its silhouettes continues along its axis, 0.48 in AFacetOfABallOrPillarUnderCorrelatedNoiseIsNoPlane.
+constexpr double kMaxContinuingShareOfAFace = 0.4;
 // Neighbouring surfaces meeting at more than this (rad, 29 deg) are two faces (a box's edge,
 // a wall's corner, an open door); a gentler turn between a region and the blocks around it
 // may be one surface curving on (a ball, a pillar) and is tested as such (continuesAndBends).
@@ -209,12 +214,20 @@ public:
   // significantly better (p < 0.001: its chi^2 drop over 3 degrees of freedom against the
   // noise model, or as an F test against their own scatter about the quadric) and its larger
   // principal curvature exceeds what a plane may have (a pillar's, a ball's or a can's side)
-  // with a sag over the region's width beyond kMaxPlaneSag (beyond kSurfaceWarp when only the
-  // F test finds the bend).
-  bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
+  // with a sag over the region's width beyond max_sag (beyond kSurfaceWarp when only the F
+  // test finds the bend).
+  bool centroidsBend(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d,
+                     double max_sag = kMaxPlaneSag) const;
   // True when the blocks' own normals turn across the region, significantly beyond their
-  // measured scatter and by more than a plane's curvature and sag may be (a pillar's or can's side).
-  bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal) const;
+  // measured scatter and by more than a plane's curvature and sag (max_sag) may be (a pillar's
+  // or can's side).
+  bool normalsTurn(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double max_sag = kMaxPlaneSag) const;
+  // True when the region ends where its surface does: of the blocks around it and its sides on
+  // the image's edge, under kMaxContinuingShareOfAFace continue it (as continuesAndBends counts
+  // them), lie on its plane without a normal of their own to show a crease, or are the image's
+  // edge; the rest are creases, depth jumps or no returns. Such a region is a whole face, and a
+  // real face bows (kSurfaceWarp); a region that continues is judged with its continuation.
+  bool endsWhereItsSurfaceDoes(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d) const;
   // True when the region did not end where its surface does and that surface bends: half or more
   // of the blocks around it (the image's edge counted as a boundary) continue it (flat, within
   // merge_distance and their noise of its plane, turned less than kCreaseAngle from it), and
@@ -231,6 +244,14 @@ public:
 private:
   // Its ray meets the plane under ~6 deg: its centroid lies on any plane along that ray.
   bool grazes(int block, const Eigen::Vector3d& normal) const;
+  // The blocks around `blocks` that continue its surface (flat, on its plane within
+  // merge_distance and their noise, turned less than kCreaseAngle) into `continuing`; returns
+  // how many blocks and image-edge sides lie around it; in `unoriented_on_plane` how many others
+  // lie on the plane as those do but have no informative normal of their own, in
+  // `image_edge_sides` how many of its blocks' sides lie on the image's edge.
+  size_t continuingBlocks(const std::vector<int>& blocks, const Eigen::Vector3d& normal, double d,
+                          std::vector<int>& continuing, size_t* unoriented_on_plane = nullptr,
+                          size_t* image_edge_sides = nullptr) const;
   // One breadth-first sweep from `blocks` over neighbours not taken that accepts() admits;
   // returns how many joined.
   size_t sweep(std::vector<int>& blocks, const std::vector<char>& taken, const Eigen::Vector3d& normal, double d,

@@ -38,14 +38,16 @@ public:
   // True when the block centroids of a fitted plane scatter no more than the sensor's noise.
   bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;
   // True when the fits of the two halves of blocks[begin, end) agree within max_angle (and,
-  // for block regions, within what the halves' noise explains).
-  bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle) const;
+  // for block regions, within what the halves' noise explains, or bowing by no more than
+  // max_sag over the blocks' width).
+  bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle,
+                   double max_sag = 0.0) const;
   // Drops the connected patches of `blocks` that are tiny, narrower than min_span blocks
-  // across the image, whose halves tilt apart by more than max_angle (curved) or that fail
-  // `also`; moments of the rest, and in `kept` how many patches are left.
+  // across the image, whose halves tilt apart by more than max_angle (curved; halvesAgree with
+  // max_sag) or that fail `also`; moments of the rest, and in `kept` how many patches are left.
   PointMoments keepFlatComponents(std::vector<int>& blocks, double max_angle, int min_span,
                                   const std::function<bool(const std::vector<int>&)>& also = nullptr,
-                                  int* kept = nullptr) const;
+                                  int* kept = nullptr, double max_sag = 0.0) const;
   // `interior`: a plane of the camera-frame normal explains the blocks (their interior when it
   // has kMinInteriorBlocks: rim blocks may straddle a fold) about as well as their own best
   // plane: a likelihood-ratio test, chi^2 increase below kMaxSnapChi2Increase.
