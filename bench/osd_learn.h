@@ -84,6 +84,17 @@ struct OsdRimCheck
   double without_8px = 0.0;
 };
 
+// A found entry against its interior (its 6 mm band without the outer 8 px, fitted again): our
+// normal's angle to it, the annotation's, and the annotation's signed tilt from it along the face
+// toward the camera and across that (rad): see osdInteriorMarkdown.
+struct OsdInteriorFit
+{
+  double ours = 0.0;
+  double annotation = 0.0;
+  double annotation_toward_camera = 0.0;
+  double annotation_across = 0.0;
+};
+
 struct OsdResults
 {
   std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
@@ -98,11 +109,15 @@ struct OsdResults
   // the model's centroid variance (median 0.455, chi^2 with 1 dof, for errors as modelled).
   std::vector<double> table_block_spread, table_centroid_chi2;
   std::vector<OsdRimCheck> rim_checks;  // ours, single frame
+  std::vector<OsdInteriorFit> interior_fits;  // ours, single frame, every found entry with an interior
 };
 
 // How far the annotation's normal moves without the faces' outer pixels, beside ours, as one
 // markdown line: the scale below which E_angle cannot tell methods apart on these frames.
 std::string osdRimMarkdown(const OsdResults& results);
+// Ours and the annotation against the found entries' interiors, and the annotation's lean toward
+// the camera, as one markdown line: whether E_angle measures us or the annotation's outlines.
+std::string osdInteriorMarkdown(const OsdResults& results);
 // The median of each of results' noise samples, as one markdown line.
 std::string osdNoiseMarkdown(const OsdResults& results);
 
