@@ -332,7 +332,7 @@ std::vector<char> erodeMask(const std::vector<char>& mask, int width, int height
 
 // How much the annotation's normal owes to a face's outer pixels. An entry is the least-squares
 // plane of its object's points within 6 mm (README); that band without its outer 8 px, which a
-// detector working on 16 px blocks does not claim, is its interior. Where the band reproduces the
+// detector working on 8 px blocks does not claim, is its interior. Where the band reproduces the
 // entry (another face's fold in the band would not), the band is also fitted without its outer 4 px.
 void rimSensitivity(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<Entry>& entries,
                     const std::vector<bool>& found, const std::vector<double>& our_angles,
