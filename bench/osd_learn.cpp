@@ -365,8 +365,11 @@ void rimSensitivity(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::
     if (without8.dot(e.normal) < 0.0) without8 = -without8;
     // The annotation's tilt from the interior, split along the face toward the camera (the ray to
     // the band's centroid, less its part along the normal) and across that.
+    // Seen head-on the face has no such direction; its tilt then counts as across.
     const Eigen::Vector3d ray = centroid / band_pixels;
-    const Eigen::Vector3d toward_camera = -(ray - without8 * without8.dot(ray)).normalized();
+    const Eigen::Vector3d along = ray - without8 * without8.dot(ray);
+    const Eigen::Vector3d toward_camera =
+        along.norm() > 1e-9 ? Eigen::Vector3d(-along.normalized()) : Eigen::Vector3d(without8.unitOrthogonal());
     const Eigen::Vector3d tilt = e.normal - without8 * without8.dot(e.normal);
     results.interior_fits.push_back({unsignedAngle(our_normals[i], without8), unsignedAngle(e.normal, without8),
                                      tilt.dot(toward_camera), tilt.dot(without8.cross(toward_camera))});

@@ -203,8 +203,8 @@ PointMoments PlanarityTests::keepFlatComponents(std::vector<int>& blocks, double
       y_min = std::min(y_min, b / bx_count), y_max = std::max(y_max, b / bx_count);
     }
     const bool wide_enough = x_max - x_min + 1 >= min_span && y_max - y_min + 1 >= min_span;
-    if (component.size() >= kMinComponentBlocks && wide_enough && halvesAgree(component, 0, component.size(), max_angle, max_sag) &&
-        (!also || also(component)))
+    if (component.size() >= kMinComponentBlocks && wide_enough &&
+        halvesAgree(component, 0, component.size(), max_angle, max_sag) && (!also || also(component)))
     {
       kept.insert(kept.end(), component.begin(), component.end());
       if (kept_count) ++*kept_count;
