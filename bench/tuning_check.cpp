@@ -297,7 +297,8 @@ int main(int argc, char** argv)
        "comma-separated: tuning (seeds 901-908), development (950-965), development-c1 (the same at C = 1), "
        "development-b (300-339 at C = 1), development-b-own (the same at each room's C), development-c (600-679 at "
        "each room's C), development-c-c1 (the same at C = 1, the held-out verdict's condition; not in the default), "
-       "development-d (700-899 at C = 1, as the held-out verdict; not in the default), table3, other, fig7 "
+       "development-d (700-899 at C = 1, as the held-out verdict; not in the default), seed-N (room N alone at C = 1), "
+       "table3, other, fig7 "
        "(default: all but development-c-c1 and development-d)")
       ("osd", po::value(&osd_dir)->value_name("DIR"), "also osd-learn's real frames (annotations.json beside learn*.pcd)")
       ("causes", "our misses of each set by what became of their candidate, and its false detections by this "
@@ -388,6 +389,13 @@ int main(int argc, char** argv)
       runs.push_back([&] { return runRooms("development C seeds, C = 1", kThirdDevelopmentSeeds, params_for, 1.0); });
     else if (set == "development-d")
       runs.push_back([&] { return runRooms("development D seeds, C = 1", kFourthDevelopmentSeeds, params_for, 1.0); });
+    else if (set.rfind("seed-", 0) == 0 && set.size() > 5 &&
+             set.find_first_not_of("0123456789", 5) == std::string::npos)
+    {
+      // One procedural room at C = 1: a room a set's --per-room file singles out, with --list.
+      const std::vector<uint32_t> one{static_cast<uint32_t>(std::stoul(set.substr(5)))};
+      runs.push_back([&, one] { return runRooms("one room, C = 1", one, params_for, 1.0); });
+    }
     else if (set == "table3")
       runs.push_back([&] { return runTableThree(params_for); });
     else if (set == "other")
@@ -396,7 +404,7 @@ int main(int argc, char** argv)
       runs.push_back([&] { return runFigureSeven(params_for); });
     else
     {
-      std::cerr << "tuning_check: unknown set '" << set << "' (tuning, development, development-c1, development-b, development-b-own, development-c, development-c-c1, development-d, table3, other, fig7)\n";
+      std::cerr << "tuning_check: unknown set '" << set << "' (tuning, development, development-c1, development-b, development-b-own, development-c, development-c-c1, development-d, seed-N, table3, other, fig7)\n";
       return 2;
     }
   }
