@@ -39,7 +39,8 @@ public:
   bool isPlanarFit(const PointMoments& moments, const std::vector<int>& blocks) const;
   // True when the fits of the two halves of blocks[begin, end) agree within max_angle (and,
   // for block regions, within what the halves' noise explains, or bowing by no more than
-  // max_sag over the blocks' width).
+  // max_sag over the blocks' width). The windows (region_growing 0) never reach max_sag; its
+  // default 0, any bend the noise shows, is the parallel search's, where pillars are the risk.
   bool halvesAgree(const std::vector<int>& blocks, size_t begin, size_t end, double max_angle,
                    double max_sag = 0.0) const;
   // Drops the connected patches of `blocks` that are tiny, narrower than min_span blocks
