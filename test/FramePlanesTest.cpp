@@ -88,6 +88,66 @@ TEST(FramePlaneFitter, ASnapPrefersTheKnownPlaneThePieceLiesOn)
   EXPECT_NEAR(std::abs(d), std::abs(wall.d), 0.02);
 }
 
+// The same wall piece and a surface turned 0.03 rad about the vertical, 1 m behind it, that its
+// blocks cannot tell from the wall. As a map plane (measured in earlier frames) its direction is
+// taken; as another region of this frame, with the world's up known, it is not: that region
+// shares this frame's depth errors, which real cameras correlate over many pixels (a frame's
+// walls turned alike). A floor piece still takes a level region's direction of this frame
+// (gravity's), and without an up this frame's surfaces are the only references.
+TEST(FramePlaneFitter, WithTheUpKnownAFaceTakesADirectionOffTheVerticalOnlyFromTheMap)
+{
+  Frame f;
+  const int bx_count = f.frame.blocksX();
+  // A 3 x 3 block piece around the middle of a true plane's blocks.
+  auto piece = [&](const std::string& name) {
+    const std::vector<int> on = f.blocksOn(f.truePlane(name));
+    const int middle = on[on.size() / 2];
+    std::vector<int> blocks;
+    for (int b : on)
+      if (std::abs(b % bx_count - middle % bx_count) <= 1 && std::abs(b / bx_count - middle / bx_count) <= 1)
+        blocks.push_back(b);
+    return blocks;
+  };
+  struct Case
+  {
+    const char* plane;
+    double turn;
+    Eigen::Vector3d axis;
+    bool frame_direction_taken_with_up;
+  };
+  for (const Case& c : {Case{"wall", 0.03, Eigen::Vector3d::UnitZ(), false},
+                        Case{"floor", 0.01, Eigen::Vector3d::UnitY(), true}})
+  {
+    const TruePlane& truth = f.renderer.truePlanes()[f.truePlane(c.plane)];
+    const std::vector<int> blocks = piece(c.plane);
+    ASSERT_EQ(blocks.size(), 9u) << c.plane;
+    const Eigen::Vector3d turned_normal = Eigen::AngleAxisd(c.turn, c.axis) * truth.normal;
+    const double turned_d = -turned_normal.dot(-truth.d * truth.normal + 1.0 * truth.normal);
+    DetectedPlane in_map;
+    in_map.normal = turned_normal;
+    in_map.d = turned_d;
+    FramePlane in_frame;
+    in_frame.normal = turned_normal;
+    in_frame.d = turned_d;
+    for (int up_known = 0; up_known <= 1; ++up_known)
+    {
+      f.params.world_z_up = up_known;
+      FramePlaneFitter fitter(f.params, f.param, f.frame, f.tests);
+      SCOPED_TRACE(std::string(c.plane) + ", world_z_up " + std::to_string(up_known));
+      Eigen::Vector3d normal = truth.normal;
+      double d = truth.d;
+      ASSERT_TRUE(fitter.snapToKnownDirection(normal, d, blocks, {in_map}, {}))
+          << "the piece's blocks must not tell the turn, or this shows nothing";
+      EXPECT_LT(angleBetween(normal, turned_normal), 1e-9);
+      normal = truth.normal;
+      d = truth.d;
+      const bool taken = !up_known || c.frame_direction_taken_with_up;
+      EXPECT_EQ(fitter.snapToKnownDirection(normal, d, blocks, {}, {in_frame}), taken);
+      EXPECT_LT(angleBetween(normal, taken ? turned_normal : truth.normal), 1e-9);
+    }
+  }
+}
+
 // A wall patch of 81 blocks and a known plane turned 0.02 rad about the vertical: the noise
 // model cannot tell the two normals apart (rendered faces scatter well below it), the
 // patch's own scatter can. With the world's up known, a face off the vertical keeps its own

@@ -624,7 +624,13 @@ const Eigen::Vector3d* FramePlaneFitter::knownNormalFor(const Eigen::Vector3d& n
     }
   };
   for (const DetectedPlane& plane : map_planes) consider(plane.normal, plane.d);
-  for (const FramePlane& plane : planes) consider(plane.normal, plane.d);
+  // With the world's up known, a direction off the vertical comes from the map only: this
+  // frame's other regions share its depth errors (a structured-light camera's are correlated
+  // over many pixels and tilt a face's fit without residuals), so their directions are no
+  // independent reference, while the map's were measured in earlier frames and gravity's is
+  // exact. Without an up this frame's surfaces are all there is (a box top on its table).
+  for (const FramePlane& plane : planes)
+    if (!params_.world_z_up || isLevelSurfaceNormal(plane.normal)) consider(plane.normal, plane.d);
   if (on_that_plane) *on_that_plane = closest_on != nullptr;
   return closest_on ? closest_on : closest;
 }
