@@ -88,8 +88,8 @@ TEST(FramePlaneFitter, ASnapPrefersTheKnownPlaneThePieceLiesOn)
   EXPECT_NEAR(std::abs(d), std::abs(wall.d), 0.02);
 }
 
-// The same wall piece and a surface turned 0.03 rad about the vertical, 1 m behind it, that its
-// blocks cannot tell from the wall. As a map plane (measured in earlier frames) its direction is
+// A 3 x 3 block piece of the wall and a surface turned 0.03 rad about the vertical, 1 m behind
+// it, that its blocks cannot tell from the wall. As a map plane (measured in earlier frames) its direction is
 // taken; as another region of this frame, with the world's up known, it is not: that region
 // shares this frame's depth errors, which real cameras correlate over many pixels (a frame's
 // walls turned alike). A floor piece still takes a level region's direction of this frame
