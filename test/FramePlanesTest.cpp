@@ -89,25 +89,14 @@ TEST(FramePlaneFitter, ASnapPrefersTheKnownPlaneThePieceLiesOn)
 }
 
 // A 3 x 3 block piece of the wall and a surface turned 0.03 rad about the vertical, 1 m behind
-// it, that its blocks cannot tell from the wall. As a map plane (measured in earlier frames) its direction is
-// taken; as another region of this frame, with the world's up known, it is not: that region
-// shares this frame's depth errors, which real cameras correlate over many pixels (a frame's
-// walls turned alike). A floor piece still takes a level region's direction of this frame
-// (gravity's), and without an up this frame's surfaces are the only references.
+// it, that its blocks cannot tell from the wall. As a map plane (measured in earlier frames)
+// its direction is taken; as another region of this frame, with the world's up known, it is
+// not: that region shares this frame's depth errors, which real cameras correlate over many
+// pixels (a frame's walls turned alike). A floor piece still takes a level region's direction
+// of this frame (gravity's), and without an up this frame's surfaces are the only references.
 TEST(FramePlaneFitter, WithTheUpKnownAFaceTakesADirectionOffTheVerticalOnlyFromTheMap)
 {
   Frame f;
-  const int bx_count = f.frame.blocksX();
-  // A 3 x 3 block piece around the middle of a true plane's blocks.
-  auto piece = [&](const std::string& name) {
-    const std::vector<int> on = f.blocksOn(f.truePlane(name));
-    const int middle = on[on.size() / 2];
-    std::vector<int> blocks;
-    for (int b : on)
-      if (std::abs(b % bx_count - middle % bx_count) <= 1 && std::abs(b / bx_count - middle / bx_count) <= 1)
-        blocks.push_back(b);
-    return blocks;
-  };
   struct Case
   {
     const char* plane;
@@ -119,7 +108,7 @@ TEST(FramePlaneFitter, WithTheUpKnownAFaceTakesADirectionOffTheVerticalOnlyFromT
                         Case{"floor", 0.01, Eigen::Vector3d::UnitY(), true}})
   {
     const TruePlane& truth = f.renderer.truePlanes()[f.truePlane(c.plane)];
-    const std::vector<int> blocks = piece(c.plane);
+    const std::vector<int> blocks = f.squareOn(c.plane, 3);
     ASSERT_EQ(blocks.size(), 9u) << c.plane;
     const Eigen::Vector3d turned_normal = Eigen::AngleAxisd(c.turn, c.axis) * truth.normal;
     const double turned_d = -turned_normal.dot(-truth.d * truth.normal + 1.0 * truth.normal);
@@ -159,17 +148,6 @@ TEST(FramePlaneFitter, WithTheUpKnownAFaceTakesADirectionOffTheVerticalOnlyFromT
 TEST(FramePlaneFitter, AFaceOffTheVerticalSnapsOnlyIfItsOwnScatterCannotTellTheNormals)
 {
   Frame f;
-  const int bx_count = f.frame.blocksX();
-  // The blocks of a true plane within a k x k square around the middle one of its list.
-  auto patch = [&](const std::string& name, int k) {
-    const std::vector<int> on = f.blocksOn(f.truePlane(name));
-    const int middle = on[on.size() / 2];
-    std::vector<int> blocks;
-    for (int b : on)
-      if (std::abs(b % bx_count - middle % bx_count) <= k / 2 && std::abs(b / bx_count - middle / bx_count) <= k / 2)
-        blocks.push_back(b);
-    return blocks;
-  };
   struct Case
   {
     const char* plane;
@@ -182,7 +160,7 @@ TEST(FramePlaneFitter, AFaceOffTheVerticalSnapsOnlyIfItsOwnScatterCannotTellTheN
                         Case{"floor", 9, 0.01, Eigen::Vector3d::UnitY(), true}})
   {
     const TruePlane& truth = f.renderer.truePlanes()[f.truePlane(c.plane)];
-    const std::vector<int> blocks = patch(c.plane, c.k);
+    const std::vector<int> blocks = f.squareOn(c.plane, c.k);
     ASSERT_GT(blocks.size(), 40u) << c.plane;
     PointMoments points;
     for (int b : blocks) points.add(f.frame.moments(b));

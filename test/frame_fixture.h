@@ -71,6 +71,17 @@ struct Frame
     }
     return out;
   }
+  // The blocks of true plane `name` within a k x k square around the middle one of its list.
+  std::vector<int> squareOn(const std::string& name, int k) const
+  {
+    const std::vector<int> on = blocksOn(truePlane(name));
+    const int bx_count = frame.blocksX(), middle = on[on.size() / 2];
+    std::vector<int> blocks;
+    for (int b : on)
+      if (std::abs(b % bx_count - middle % bx_count) <= k / 2 && std::abs(b / bx_count - middle / bx_count) <= k / 2)
+        blocks.push_back(b);
+    return blocks;
+  }
   // The middle image row of the blocks.
   int wallRow(const std::vector<int>& blocks) const
   {
