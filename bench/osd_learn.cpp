@@ -381,6 +381,71 @@ void rimSensitivity(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::
   }
 }
 
+// Each entry of a frame with a table, by kind, with our error on it (see OsdEntryAngle).
+void entryAngles(const std::vector<Entry>& entries, const std::vector<bool>& found,
+                 const std::vector<double>& our_angles, const std::vector<Eigen::Vector3d>& our_normals,
+                 OsdResults& results)
+{
+  constexpr double kParallelToTable = 0.2;  // rad: the annotated tops lie within 0.08, the sides near pi/2
+  constexpr double kSameNormal = 1e-6;      // rad: a snapped plane has the known normal to rounding
+  const auto table = std::find_if(entries.begin(), entries.end(), [](const Entry& e) { return e.object == 0; });
+  if (table == entries.end()) return;
+  const size_t t = static_cast<size_t>(table - entries.begin());
+  // Along the table toward the camera: the optical axis on the table's plane, reversed.
+  const Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d toward_camera = -(axis - table->normal * table->normal.dot(axis)).normalized();
+  for (size_t i = 0; i < entries.size(); ++i)
+  {
+    OsdEntryAngle angle;
+    angle.found = found[i];
+    angle.ours = our_angles[i];
+    angle.annotated_to_table = unsignedAngle(entries[i].normal, table->normal);
+    if (i == t)
+      angle.kind = OsdEntryAngle::Kind::kTable;
+    else if (angle.annotated_to_table <= kParallelToTable)
+      angle.kind = OsdEntryAngle::Kind::kParallelToTable;
+    const double sign = entries[i].normal.dot(table->normal) >= 0.0 ? 1.0 : -1.0;
+    angle.annotated_toward_camera = (sign * entries[i].normal - table->normal).dot(toward_camera);
+    angle.ours_parallel_to_our_table =
+        i != t && found[i] && found[t] && unsignedAngle(our_normals[i], our_normals[t]) <= kSameNormal;
+    results.entry_angles.push_back(angle);
+  }
+}
+
+// Where each object of a joined entry lies from its plane (see OsdJoinedEntry).
+void joinedEntries(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::string& frame,
+                   const std::vector<Entry>& entries, OsdResults& results)
+{
+  constexpr double kBin = 0.002;  // m
+  const int bins = static_cast<int>(std::lround(2.0 * kMatchDistance / kBin));
+  for (const Entry& e : entries)
+  {
+    std::set<int> objects;  // label / 10 of each "objNN" part of the name
+    for (size_t at = e.name.find("obj"); at != std::string::npos; at = e.name.find("obj", at + 3))
+      objects.insert(std::stoi(e.name.substr(at + 3, 2)) / 10);
+    if (objects.size() < 2) continue;
+    OsdJoinedEntry joined{frame, e.name, {}};
+    for (int object : objects)
+    {
+      std::vector<int> histogram(static_cast<size_t>(bins), 0);
+      for (int v = std::max(0, e.box[1]); v <= std::min(static_cast<int>(cloud.height) - 1, e.box[3]); ++v)
+        for (int u = std::max(0, e.box[0]); u <= std::min(static_cast<int>(cloud.width) - 1, e.box[2]); ++u)
+        {
+          const pcl::PointXYZRGBL& q = cloud.at(u, v);
+          if (q.label < 20 || static_cast<int>(q.label / 10) != object || !std::isfinite(q.z)) continue;
+          const double distance = e.normal.dot(Eigen::Vector3d(q.x, q.y, q.z)) + e.d;
+          const int bin = static_cast<int>(std::floor((distance + kMatchDistance) / kBin));
+          if (bin >= 0 && bin < bins) ++histogram[static_cast<size_t>(bin)];
+        }
+      const auto mode = std::max_element(histogram.begin(), histogram.end());
+      const double offset = *mode == 0 ? std::nan("")
+                                       : (static_cast<double>(mode - histogram.begin()) + 0.5) * kBin - kMatchDistance;
+      joined.parts.emplace_back("obj" + std::to_string(10 * object), offset);
+    }
+    results.joined_entries.push_back(joined);
+  }
+}
+
 // Objects of a curved-object frame with no annotated face: cans and mugs.
 std::set<uint32_t> curvedObjects(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<Entry>& entries)
 {
@@ -525,6 +590,8 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
       if (with_fit_errors) fitErrors(detector, view, cloud, name, entries, found, results.fit_errors);
       tableNoise(detector, entries, results);
       rimSensitivity(cloud, entries, found, our_angles, our_normals, results);
+      entryAngles(entries, found, our_angles, our_normals, results);
+      joinedEntries(cloud, name, entries, results);
       if (index >= kFirstCurvedFrame)
         single.curved_planes += planesOnCurvedObjects(detector, view, cloud, curvedObjects(cloud, entries));
       if (!picture_dir.empty() && picture_frames.count(name))
@@ -596,6 +663,8 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
   }
   if (!results.rim_checks.empty()) md += "\n" + osdRimMarkdown(results);
   if (!results.interior_fits.empty()) md += "\n" + osdInteriorMarkdown(results);
+  if (!results.entry_angles.empty()) md += "\n" + osdParallelFacesMarkdown(results);
+  if (!results.joined_entries.empty()) md += "\n" + osdJoinedEntriesMarkdown(results);
   if (!results.duplicates.empty())
   {
     md += "\nOur duplicates (one frame): each plane of ours matching an entry an earlier one matches, and where "
@@ -668,6 +737,75 @@ std::string osdInteriorMarkdown(const OsdResults& results)
                 results.interior_fits.size(), mean(ours), mean(annotation), mean(toward), toward_count,
                 results.interior_fits.size(), mean(across));
   return line;
+}
+
+std::string osdParallelFacesMarkdown(const OsdResults& results)
+{
+  using Kind = OsdEntryAngle::Kind;
+  std::vector<double> tables, parallel, snapped, unsnapped, others, annotated_to_table, toward;
+  int parallel_entries = 0, leaning_toward = 0;
+  for (const OsdEntryAngle& a : results.entry_angles)
+  {
+    if (a.kind == Kind::kParallelToTable)
+    {
+      ++parallel_entries;
+      annotated_to_table.push_back(a.annotated_to_table);
+      toward.push_back(a.annotated_toward_camera);
+      leaning_toward += a.annotated_toward_camera > 0.0;
+    }
+    if (!a.found) continue;
+    if (a.kind == Kind::kTable)
+      tables.push_back(a.ours);
+    else if (a.kind == Kind::kOther)
+      others.push_back(a.ours);
+    else
+    {
+      parallel.push_back(a.ours);
+      (a.ours_parallel_to_our_table ? snapped : unsnapped).push_back(a.ours);
+    }
+  }
+  char line[1024];
+  std::snprintf(line, sizeof(line),
+                "E_angle by surface (one frame): tables %.4f rad (%zu found); faces parallel to their table (within "
+                "0.2 rad of its annotated normal: box tops) %.4f rad (%zu found of %d), of which %zu with our table "
+                "plane's normal (snapped to it) %.4f rad and the other %zu %.4f rad; other faces %.4f rad (%zu found). "
+                "The parallel faces' annotated normals lie %.4f rad (mean) off their table's, %d of %d leaning toward "
+                "the camera (%+.4f rad mean along the table): resting on the table they are parallel to it, so a "
+                "one-sided tilt is most likely the sensor's; a fit of each face's own points (the annotation's) keeps "
+                "it, a snap to the table's direction removes it.\n",
+                mean(tables), tables.size(), mean(parallel), parallel.size(), parallel_entries, snapped.size(),
+                mean(snapped), unsnapped.size(), mean(unsnapped), mean(others), others.size(), mean(annotated_to_table),
+                leaning_toward, parallel_entries, mean(toward));
+  return line;
+}
+
+std::string osdJoinedEntriesMarkdown(const OsdResults& results)
+{
+  constexpr double kAnnotationBand = 0.006;  // m: the annotation's RANSAC distance
+  std::string md =
+      "Entries joining faces of several objects, and where each object's points nearest the entry's plane lie "
+      "(mode of 2 mm bins within 3 cm, in its box; + toward the camera):";
+  int apart = 0;
+  char part[96];
+  for (const OsdJoinedEntry& joined : results.joined_entries)
+  {
+    md += " " + joined.frame + " " + joined.entry + ":";
+    for (const auto& [object, offset] : joined.parts)
+    {
+      if (std::isnan(offset))
+        std::snprintf(part, sizeof(part), " %s none,", object.c_str());
+      else
+        std::snprintf(part, sizeof(part), " %s %+.0f mm,", object.c_str(), 1000.0 * offset);
+      md += part;
+      apart += std::isfinite(offset) && std::abs(offset) > kAnnotationBand;
+    }
+    md.back() = ';';
+  }
+  md += " " + std::to_string(apart) +
+        " part(s) lie more than the annotation's 6 mm band off their entry's plane: each a surface of its own that "
+        "the entry matches within 3 cm, so a detector that keeps it apart from the entry's plane reports a duplicate "
+        "of the entry.\n";
+  return md;
 }
 
 std::string osdNoiseMarkdown(const OsdResults& results)

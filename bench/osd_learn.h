@@ -95,6 +95,32 @@ struct OsdInteriorFit
   double annotation_across = 0.0;
 };
 
+// An annotated entry of a frame with a table, for E_angle by kind of surface. A face within
+// kParallelToTable of the table's annotated normal rests parallel to it in the world (a box top):
+// the angle between their annotated normals is the sensor's error, which a fit of the face's own
+// points (the annotation's, and a detector's unsnapped plane) shares and a snap to the table's
+// direction does not.
+struct OsdEntryAngle
+{
+  enum class Kind { kTable, kParallelToTable, kOther };
+  Kind kind = Kind::kOther;
+  bool found = false;
+  double ours = 0.0;                  // our E_angle (rad), when found
+  bool ours_parallel_to_our_table = false;  // our plane has our table plane's normal (snapped to it)
+  double annotated_to_table = 0.0;    // angle between the entry's and the table's annotated normals (rad)
+  double annotated_toward_camera = 0.0;  // the entry's normal less the table's, along the table toward the camera
+};
+
+// An entry the annotation joined from faces of several objects (README: faces of one infinite
+// plane), and where each object's points nearest its plane lie: the mode of their distance (2 mm
+// bins, within the 3 cm match, in the entry's box; + toward the camera). A part further off than
+// the annotation's 6 mm band is a surface of its own that the entry still matches.
+struct OsdJoinedEntry
+{
+  std::string frame, entry;
+  std::vector<std::pair<std::string, double>> parts;  // object (obj20, ...), offset (m; NaN: no points)
+};
+
 struct OsdResults
 {
   std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
@@ -110,6 +136,8 @@ struct OsdResults
   std::vector<double> table_block_spread, table_centroid_chi2;
   std::vector<OsdRimCheck> rim_checks;  // ours, single frame
   std::vector<OsdInteriorFit> interior_fits;  // ours, single frame, every found entry with an interior
+  std::vector<OsdEntryAngle> entry_angles;    // ours, single frame, every entry of a frame with a table
+  std::vector<OsdJoinedEntry> joined_entries;  // the annotation's entries over several objects
 };
 
 // How far the annotation's normal moves without the faces' outer pixels, beside ours, as one
@@ -118,6 +146,12 @@ std::string osdRimMarkdown(const OsdResults& results);
 // Ours and the annotation against the found entries' interiors, and the annotation's lean toward
 // the camera, as one markdown line: whether E_angle measures us or the annotation's outlines.
 std::string osdInteriorMarkdown(const OsdResults& results);
+// E_angle by kind of surface (tables, faces parallel to their table, other faces), with the
+// annotated angle of the parallel faces to their table, as one markdown line: how much of E_angle
+// is the sensor's tilt between surfaces the scene holds parallel.
+std::string osdParallelFacesMarkdown(const OsdResults& results);
+// The joined entries and their parts' offsets, as one markdown line ("" when there are none).
+std::string osdJoinedEntriesMarkdown(const OsdResults& results);
 // The median of each of results' noise samples, as one markdown line.
 std::string osdNoiseMarkdown(const OsdResults& results);
 
