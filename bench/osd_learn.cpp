@@ -801,11 +801,12 @@ std::string osdJoinedEntriesMarkdown(const OsdResults& results)
     }
     md.back() = ';';
   }
-  md += " " + std::to_string(apart) +
-        " part(s) lie more than the annotation's 6 mm band off their entry's plane: each a surface of its own that "
-        "the entry matches within 3 cm, so a detector that keeps it apart from the entry's plane reports a duplicate "
-        "of the entry.\n";
-  return md;
+  if (apart == 0)
+    return md + " every part lies within the annotation's 6 mm band of its entry's plane.\n";
+  return md + " " + std::to_string(apart) +
+         " part(s) lie more than the annotation's 6 mm band off their entry's plane: each a surface of its own that "
+         "the entry matches within 3 cm, so a detector that keeps it apart from the entry's plane reports a "
+         "duplicate of the entry.\n";
 }
 
 std::string osdNoiseMarkdown(const OsdResults& results)

@@ -96,9 +96,9 @@ struct OsdInteriorFit
 };
 
 // An annotated entry of a frame with a table, for E_angle by kind of surface. A face within
-// kParallelToTable of the table's annotated normal rests parallel to it in the world (a box top):
-// the angle between their annotated normals is the sensor's error, which a fit of the face's own
-// points (the annotation's, and a detector's unsnapped plane) shares and a snap to the table's
+// 0.2 rad of the table's annotated normal rests parallel to it in the world (a box top), so the
+// angle between their annotated normals is most likely the sensor's error: a fit of the face's
+// own points (the annotation's, a detector's unsnapped plane) keeps it, a snap to the table's
 // direction does not.
 struct OsdEntryAngle
 {
@@ -150,7 +150,7 @@ std::string osdInteriorMarkdown(const OsdResults& results);
 // annotated angle of the parallel faces to their table, as one markdown line: how much of E_angle
 // is the sensor's tilt between surfaces the scene holds parallel.
 std::string osdParallelFacesMarkdown(const OsdResults& results);
-// The joined entries and their parts' offsets, as one markdown line ("" when there are none).
+// The joined entries and their parts' offsets, as one markdown line.
 std::string osdJoinedEntriesMarkdown(const OsdResults& results);
 // The median of each of results' noise samples, as one markdown line.
 std::string osdNoiseMarkdown(const OsdResults& results);
