@@ -187,6 +187,62 @@ bool maskedPlaneNormal(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const st
 
 // For each found entry: our matching plane's error and that of the least-squares plane of
 // the pixels we label with it (the table anywhere, a face inside its box with a margin).
+// The map plane that matches the entry best (the scoring's cost), or nullptr.
+const DetectedPlane* bestMatchingPlane(const PlaneDetector& detector, const Entry& e)
+{
+  const DetectedPlane* best = nullptr;
+  double best_cost = 1e9, a, dd;
+  for (const DetectedPlane& p : detector.planes())
+    if (matches(p.normal, p.d, e, &a, &dd) && a / kMatchAngle + dd / kMatchDistance < best_cost)
+    {
+      best_cost = a / kMatchAngle + dd / kMatchDistance;
+      best = &p;
+    }
+  return best;
+}
+
+// Whether a point lies on the entry's face: on its object (the table: labels 1-9) and within
+// the annotation's 6 mm of its plane.
+constexpr double kAnnotationBand = 0.006;  // m, the annotation's RANSAC distance
+bool onEntryFace(const pcl::PointXYZRGBL& q, const Entry& e)
+{
+  const bool on_object =
+      e.object == 0 ? q.label >= 1 && q.label <= 9 : q.label >= 20 && static_cast<int>(q.label / 10) == e.object;
+  return on_object && std::isfinite(q.z) &&
+         std::abs(e.normal.dot(Eigen::Vector3d(q.x, q.y, q.z)) + e.d) <= kAnnotationBand;
+}
+
+// The pixels we label with each found entry's plane (the nodelet's ~inliers) against the points
+// of the entry's face: see OsdInlierCoverage.
+void inlierCoverage(const PlaneDetector& detector, const CloudView& view,
+                    const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<Entry>& entries,
+                    const std::vector<bool>& found, OsdResults& results)
+{
+  std::vector<int> labels;
+  detector.labelPixels(view, labels);
+  for (size_t i = 0; i < entries.size(); ++i)
+  {
+    if (!found[i]) continue;
+    const Entry& e = entries[i];
+    const DetectedPlane* best = bestMatchingPlane(detector, e);
+    if (!best) continue;
+    OsdInlierCoverage coverage;
+    coverage.table = e.object == 0;
+    for (size_t p = 0; p < labels.size(); ++p)
+    {
+      const pcl::PointXYZRGBL& q = cloud.points[p];
+      const bool ours = labels[p] == best->id && std::isfinite(q.z);
+      const bool face = onEntryFace(q, e);
+      coverage.face += face;
+      coverage.ours += ours;
+      coverage.both += ours && face;
+      coverage.ours_on_plane +=
+          ours && std::abs(e.normal.dot(Eigen::Vector3d(q.x, q.y, q.z)) + e.d) <= kAnnotationBand;
+    }
+    results.inlier_coverage.push_back(coverage);
+  }
+}
+
 void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::PointCloud<pcl::PointXYZRGBL>& cloud,
                const std::string& frame, const std::vector<Entry>& entries, const std::vector<bool>& found,
                std::vector<OsdFitError>& out)
@@ -198,14 +254,7 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
   {
     if (!found[i]) continue;
     const Entry& e = entries[i];
-    const DetectedPlane* best = nullptr;
-    double best_cost = 1e9, a, dd;
-    for (const DetectedPlane& p : detector.planes())
-      if (matches(p.normal, p.d, e, &a, &dd) && a / kMatchAngle + dd / kMatchDistance < best_cost)
-      {
-        best_cost = a / kMatchAngle + dd / kMatchDistance;
-        best = &p;
-      }
+    const DetectedPlane* best = bestMatchingPlane(detector, e);
     if (!best) continue;
     int labelled = 0;
     std::vector<char> ours(labels.size(), 0);
@@ -338,7 +387,6 @@ void rimSensitivity(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::
                     const std::vector<bool>& found, const std::vector<double>& our_angles,
                     const std::vector<Eigen::Vector3d>& our_normals, OsdResults& results)
 {
-  constexpr double kBand = 0.006;        // m, the annotation's RANSAC distance
   constexpr double kReproduced = 0.005;  // rad: the band's own fit is the entry
   constexpr int kMinPixels = 100;        // for a face's fit after erosion
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
@@ -352,12 +400,9 @@ void rimSensitivity(const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::
     for (size_t p = 0; p < cloud.points.size(); ++p)
     {
       const pcl::PointXYZRGBL& q = cloud.points[p];
-      const bool on_object = e.object == 0 ? q.label >= 1 && q.label <= 9
-                                           : q.label >= 20 && static_cast<int>(q.label / 10) == e.object;
-      const Eigen::Vector3d x(q.x, q.y, q.z);
-      band[p] = on_object && std::isfinite(q.z) && std::abs(e.normal.dot(x) + e.d) <= kBand;
+      band[p] = onEntryFace(q, e);
       if (!band[p]) continue;
-      centroid += x;
+      centroid += Eigen::Vector3d(q.x, q.y, q.z);
       ++band_pixels;
     }
     Eigen::Vector3d whole, without4, without8;
@@ -591,6 +636,7 @@ bool evaluateOsdLearn(const std::string& dir, const DetectorParams& params, bool
       tableNoise(detector, entries, results);
       rimSensitivity(cloud, entries, found, our_angles, our_normals, results);
       entryAngles(entries, found, our_angles, our_normals, results);
+      inlierCoverage(detector, view, cloud, entries, found, results);
       joinedEntries(cloud, name, entries, results);
       if (index >= kFirstCurvedFrame)
         single.curved_planes += planesOnCurvedObjects(detector, view, cloud, curvedObjects(cloud, entries));
@@ -663,6 +709,7 @@ std::string osdLearnMarkdown(const OsdResults& results, const std::string& pictu
   }
   if (!results.rim_checks.empty()) md += "\n" + osdRimMarkdown(results);
   if (!results.interior_fits.empty()) md += "\n" + osdInteriorMarkdown(results);
+  if (!results.inlier_coverage.empty()) md += "\n" + osdInlierMarkdown(results);
   if (!results.entry_angles.empty()) md += "\n" + osdParallelFacesMarkdown(results);
   if (!results.joined_entries.empty()) md += "\n" + osdJoinedEntriesMarkdown(results);
   if (!results.duplicates.empty())
@@ -739,6 +786,31 @@ std::string osdInteriorMarkdown(const OsdResults& results)
   return line;
 }
 
+std::string osdInlierMarkdown(const OsdResults& results)
+{
+  long face[2] = {0, 0}, ours[2] = {0, 0}, both[2] = {0, 0}, on_plane[2] = {0, 0};
+  size_t entries[2] = {0, 0};
+  for (const OsdInlierCoverage& c : results.inlier_coverage)
+  {
+    const int k = c.table ? 0 : 1;
+    face[k] += c.face;
+    ours[k] += c.ours;
+    both[k] += c.both;
+    on_plane[k] += c.ours_on_plane;
+    ++entries[k];
+  }
+  auto share = [](long part, long whole) { return whole > 0 ? 100.0 * part / whole : 0.0; };
+  char line[640];
+  std::snprintf(line, sizeof(line),
+                "Inliers (the pixels we label with a found entry's plane, as ~inliers publishes them) against the "
+                "entry's face (its object's points within 6 mm of its plane), pooled: tables (%zu) %.1f %% of the "
+                "face's points labelled, %.1f %% of ours on the face and %.1f %% within 6 mm of its plane; faces "
+                "(%zu) %.1f %%, %.1f %% and %.1f %%.\n",
+                entries[0], share(both[0], face[0]), share(both[0], ours[0]), share(on_plane[0], ours[0]), entries[1],
+                share(both[1], face[1]), share(both[1], ours[1]), share(on_plane[1], ours[1]));
+  return line;
+}
+
 std::string osdParallelFacesMarkdown(const OsdResults& results)
 {
   using Kind = OsdEntryAngle::Kind;
@@ -781,7 +853,6 @@ std::string osdParallelFacesMarkdown(const OsdResults& results)
 
 std::string osdJoinedEntriesMarkdown(const OsdResults& results)
 {
-  constexpr double kAnnotationBand = 0.006;  // m: the annotation's RANSAC distance
   std::string md =
       "Entries joining faces of several objects, and where each object's points nearest the entry's plane lie "
       "(mode of 2 mm bins within 3 cm, in its box; + toward the camera):";

@@ -121,6 +121,17 @@ struct OsdJoinedEntry
   std::vector<std::pair<std::string, double>> parts;  // object (obj20, ...), offset (m; NaN: no points)
 };
 
+// A found entry's inliers: the pixels we label with its matching plane against its face (its
+// object's points within the annotation's 6 mm of its plane).
+struct OsdInlierCoverage
+{
+  bool table = false;
+  long face = 0;           // the face's points
+  long ours = 0;           // our labelled pixels (with a return)
+  long both = 0;           // ours on the face
+  long ours_on_plane = 0;  // ours within 6 mm of the entry's plane, on whatever object
+};
+
 struct OsdResults
 {
   std::vector<OsdMethodResult> methods;  // ours single frame, ours five copies, PCL RANSAC, PCL OMPS
@@ -136,6 +147,7 @@ struct OsdResults
   std::vector<double> table_block_spread, table_centroid_chi2;
   std::vector<OsdRimCheck> rim_checks;  // ours, single frame
   std::vector<OsdInteriorFit> interior_fits;  // ours, single frame, every found entry with an interior
+  std::vector<OsdInlierCoverage> inlier_coverage;  // ours, single frame, every found entry
   std::vector<OsdEntryAngle> entry_angles;    // ours, single frame, every entry of a frame with a table
   std::vector<OsdJoinedEntry> joined_entries;  // the annotation's entries over several objects
 };
@@ -146,6 +158,9 @@ std::string osdRimMarkdown(const OsdResults& results);
 // Ours and the annotation against the found entries' interiors, and the annotation's lean toward
 // the camera, as one markdown line: whether E_angle measures us or the annotation's outlines.
 std::string osdInteriorMarkdown(const OsdResults& results);
+// The inliers' share of the faces' points and the share of them on the faces, for tables and
+// for the other faces, as one markdown line.
+std::string osdInlierMarkdown(const OsdResults& results);
 // E_angle by kind of surface (tables, faces parallel to their table, other faces), with the
 // annotated angle of the parallel faces to their table, as one markdown line: how much of E_angle
 // is the sensor's tilt between surfaces the scene holds parallel.

@@ -10,6 +10,7 @@ namespace hough_plane_detector
 
 namespace
 {
+constexpr double kPixelBandSigmas = 3.0;  // a pixel on a plane lies within 3 sigma of its depth noise
 // Index of the plane a window lies on, or -1; sign-invariant.
 int bestPlaneFor(const WindowSample& sample, const std::vector<DetectedPlane>& planes, const DetectorParams& params)
 {
@@ -93,8 +94,9 @@ void labelPixels(const CloudView& cloud, const FrameData& frame, const std::vect
                  const std::vector<DetectedPlane>& planes, const DetectorParams& params, std::vector<int>& labels)
 {
   labels.assign(cloud.size(), -1);
-  const int s = blockSize(params.normal_window, params.normal_stride), bx_count = frame.blocksX();
-  if (block_labels.empty() || cloud.width / s != bx_count || cloud.height / s != frame.blocksY()) return;
+  const int s = blockSize(params.normal_window, params.normal_stride), bx_count = frame.blocksX(),
+            by_count = frame.blocksY();
+  if (block_labels.empty() || cloud.width / s != bx_count || cloud.height / s != by_count) return;
   std::unordered_map<int, std::pair<Eigen::Vector3d, double>> camera_planes;
   for (const DetectedPlane& plane : planes)
     camera_planes[plane.id] = {frame.normalInCamera(plane.normal), frame.dInCamera(plane.normal, plane.d)};
@@ -112,6 +114,55 @@ void labelPixels(const CloudView& cloud, const FrameData& frame, const std::vect
             std::abs(plane.first.dot(Eigen::Vector3d(x, y, z)) + plane.second) <= params.support_distance)
           labels[static_cast<size_t>(v) * cloud.width + u] = block_labels[b];
       }
+  }
+  // A region leaves out blocks whose centroids its noise tests put off the plane (a real
+  // sensor's depth errors are correlated over many pixels), yet their points lie on it: from its
+  // blocks a plane's label spreads to the unlabelled blocks around them, to each pixel within
+  // kPixelBandSigmas of the sensor's depth noise of the plane, and on from a block where most
+  // points lie so. A surface off the plane (an object on a table) stops it.
+  std::vector<int> spread(block_labels), refused_for(block_labels.size(), -1);  // a block is tried once per plane
+  std::vector<int> queue;
+  for (size_t b = 0; b < spread.size(); ++b)
+    if (spread[b] >= 0) queue.push_back(static_cast<int>(b));
+  for (size_t next = 0; next < queue.size(); ++next)
+  {
+    const int from = queue[next], id = spread[from];
+    const auto& plane = camera_planes[id];
+    const int fx = from % bx_count, fy = from / bx_count;
+    const int neighbours[4][2] = {{fx - 1, fy}, {fx + 1, fy}, {fx, fy - 1}, {fx, fy + 1}};
+    for (const auto& n : neighbours)
+    {
+      if (n[0] < 0 || n[0] >= bx_count || n[1] < 0 || n[1] >= by_count) continue;
+      const int b = n[1] * bx_count + n[0];
+      if (spread[b] >= 0 || refused_for[b] == id || frame.points(b) <= 0) continue;
+      int valid = 0, on_plane = 0;
+      for (int v = n[1] * s; v < (n[1] + 1) * s; ++v)
+        for (int u = n[0] * s; u < (n[0] + 1) * s; ++u)
+        {
+          float x, y, z;
+          cloud.point(u, v, x, y, z);
+          if (!std::isfinite(x + y + z)) continue;
+          ++valid;
+          // A depth error e moves the point along its ray by e / z of itself, off the plane by
+          // e |n . p| / z.
+          const Eigen::Vector3d p(x, y, z);
+          const double along_normal = plane.first.dot(p);
+          const double band = kPixelBandSigmas * frame.noise.sigma(z) * std::abs(along_normal) / z;
+          if (std::abs(along_normal + plane.second) > band) continue;
+          ++on_plane;
+          int& label = labels[static_cast<size_t>(v) * cloud.width + u];
+          if (label < 0) label = id;
+        }
+      if (valid > 0 && 2 * on_plane > valid)
+      {
+        spread[b] = id;
+        queue.push_back(b);
+      }
+      else
+      {
+        refused_for[b] = id;
+      }
+    }
   }
 }
 

@@ -29,7 +29,10 @@ void labelFrame(const DetectorParams& params, FrameData& frame, FramePlaneFitter
                 FrameLabels& labels);
 
 // Plane id of every pixel (-1: none): pixels of a labelled block within support_distance of
-// its plane. `cloud` must be the frame's cloud; nothing is labelled when its grid differs.
+// its plane, and, spreading from those blocks into unlabelled neighbours (on from a block whose
+// points lie mostly so), pixels within 3 sigma of the sensor's depth noise of the plane: the
+// blocks a region's noise tests left out. `cloud` must be the frame's cloud; nothing is
+// labelled when its grid differs.
 void labelPixels(const CloudView& cloud, const FrameData& frame, const std::vector<int>& block_labels,
                  const std::vector<DetectedPlane>& planes, const DetectorParams& params, std::vector<int>& labels);
 
