@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <set>
 
 #include <Eigen/Eigenvalues>
@@ -212,26 +213,36 @@ bool onEntryFace(const pcl::PointXYZRGBL& q, const Entry& e)
          std::abs(e.normal.dot(Eigen::Vector3d(q.x, q.y, q.z)) + e.d) <= kAnnotationBand;
 }
 
-// The pixels we label with each found entry's plane (the nodelet's ~inliers) against the points
-// of the entry's face: see OsdInlierCoverage.
-void inlierCoverage(const PlaneDetector& detector, const CloudView& view,
-                    const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<Entry>& entries,
-                    const std::vector<bool>& found, OsdResults& results)
+// Calls `visit` with each found entry, the map plane matching it best and the frame's pixel
+// labels.
+void forEachFoundEntry(const PlaneDetector& detector, const CloudView& view, const std::vector<Entry>& entries,
+                       const std::vector<bool>& found,
+                       const std::function<void(const Entry&, const DetectedPlane&, const std::vector<int>&)>& visit)
 {
   std::vector<int> labels;
   detector.labelPixels(view, labels);
   for (size_t i = 0; i < entries.size(); ++i)
   {
     if (!found[i]) continue;
-    const Entry& e = entries[i];
-    const DetectedPlane* best = bestMatchingPlane(detector, e);
-    if (!best) continue;
+    const DetectedPlane* best = bestMatchingPlane(detector, entries[i]);
+    if (best) visit(entries[i], *best, labels);
+  }
+}
+
+// The pixels we label with each found entry's plane (the nodelet's ~inliers) against the points
+// of the entry's face: see OsdInlierCoverage.
+void inlierCoverage(const PlaneDetector& detector, const CloudView& view,
+                    const pcl::PointCloud<pcl::PointXYZRGBL>& cloud, const std::vector<Entry>& entries,
+                    const std::vector<bool>& found, OsdResults& results)
+{
+  forEachFoundEntry(detector, view, entries, found, [&](const Entry& e, const DetectedPlane& best,
+                                                        const std::vector<int>& labels) {
     OsdInlierCoverage coverage;
     coverage.table = e.object == 0;
     for (size_t p = 0; p < labels.size(); ++p)
     {
       const pcl::PointXYZRGBL& q = cloud.points[p];
-      const bool ours = labels[p] == best->id && std::isfinite(q.z);
+      const bool ours = labels[p] == best.id && std::isfinite(q.z);
       const bool face = onEntryFace(q, e);
       coverage.face += face;
       coverage.ours += ours;
@@ -240,7 +251,7 @@ void inlierCoverage(const PlaneDetector& detector, const CloudView& view,
           ours && std::abs(e.normal.dot(Eigen::Vector3d(q.x, q.y, q.z)) + e.d) <= kAnnotationBand;
     }
     results.inlier_coverage.push_back(coverage);
-  }
+  });
 }
 
 void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::PointCloud<pcl::PointXYZRGBL>& cloud,
@@ -248,14 +259,8 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
                std::vector<OsdFitError>& out)
 {
   constexpr int kMargin = 10;  // px: a face's labelled pixels may reach a little past its annotated box
-  std::vector<int> labels;
-  detector.labelPixels(view, labels);
-  for (size_t i = 0; i < entries.size(); ++i)
-  {
-    if (!found[i]) continue;
-    const Entry& e = entries[i];
-    const DetectedPlane* best = bestMatchingPlane(detector, e);
-    if (!best) continue;
+  forEachFoundEntry(detector, view, entries, found, [&](const Entry& e, const DetectedPlane& best,
+                                                        const std::vector<int>& labels) {
     int labelled = 0;
     std::vector<char> ours(labels.size(), 0);
     for (int v = 0; v < view.height; ++v)
@@ -264,18 +269,18 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
         const size_t i = static_cast<size_t>(v) * view.width + u;
         const bool inside = e.object == 0 || (u >= e.box[0] - kMargin && u <= e.box[2] + kMargin &&
                                               v >= e.box[1] - kMargin && v <= e.box[3] + kMargin);
-        ours[i] = inside && std::isfinite(cloud.points[i].z) && labels[i] == best->id;
+        ours[i] = inside && std::isfinite(cloud.points[i].z) && labels[i] == best.id;
         labelled += ours[i];
       }
     OsdFitError fit{frame, e.name, e.points, labelled};
-    matches(best->normal, best->d, e, &fit.angle);
+    matches(best.normal, best.d, e, &fit.angle);
     const FramePlane* fitted = nullptr;
     double fitted_angle = kMatchAngle;
     for (const FramePlane& p : detector.lastFramePlanes())
-      if (unsignedAngle(p.normal, best->normal) <= fitted_angle &&
-          std::abs((p.normal.dot(best->normal) >= 0.0 ? p.d : -p.d) - best->d) <= kMatchDistance)
+      if (unsignedAngle(p.normal, best.normal) <= fitted_angle &&
+          std::abs((p.normal.dot(best.normal) >= 0.0 ? p.d : -p.d) - best.d) <= kMatchDistance)
       {
-        fitted_angle = unsignedAngle(p.normal, best->normal);
+        fitted_angle = unsignedAngle(p.normal, best.normal);
         fitted = &p;
       }
     if (fitted && fitted->parallel && !fitted->own_normal.isZero())
@@ -293,7 +298,7 @@ void fitErrors(const PlaneDetector& detector, const CloudView& view, const pcl::
     fit.labelled_fit_angle = maskedPlaneNormal(cloud, ours, 3, labelled_normal) ? unsignedAngle(labelled_normal, e.normal)
                                                                                  : M_PI / 2;
     out.push_back(fit);
-  }
+  });
 }
 
 // Where the pixels of each of our duplicate planes lie: see OsdDuplicate.
