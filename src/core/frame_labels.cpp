@@ -100,26 +100,30 @@ void labelPixels(const CloudView& cloud, const FrameData& frame, const std::vect
   std::unordered_map<int, std::pair<Eigen::Vector3d, double>> camera_planes;
   for (const DetectedPlane& plane : planes)
     camera_planes[plane.id] = {frame.normalInCamera(plane.normal), frame.dInCamera(plane.normal, plane.d)};
-  for (size_t b = 0; b < block_labels.size(); ++b)
-  {
-    if (block_labels[b] < 0) continue;
-    const auto& plane = camera_planes[block_labels[b]];
-    const int bx = static_cast<int>(b) % bx_count, by = static_cast<int>(b) / bx_count;
+  // Each pixel of block b with a return: its point and its label.
+  auto forEachPoint = [&](int b, const auto& visit) {
+    const int bx = b % bx_count, by = b / bx_count;
     for (int v = by * s; v < (by + 1) * s; ++v)
       for (int u = bx * s; u < (bx + 1) * s; ++u)
       {
         float x, y, z;
         cloud.point(u, v, x, y, z);
-        if (std::isfinite(x + y + z) &&
-            std::abs(plane.first.dot(Eigen::Vector3d(x, y, z)) + plane.second) <= params.support_distance)
-          labels[static_cast<size_t>(v) * cloud.width + u] = block_labels[b];
+        if (std::isfinite(x + y + z)) visit(Eigen::Vector3d(x, y, z), labels[static_cast<size_t>(v) * cloud.width + u]);
       }
+  };
+  for (size_t b = 0; b < block_labels.size(); ++b)
+  {
+    if (block_labels[b] < 0) continue;
+    const auto& plane = camera_planes[block_labels[b]];
+    forEachPoint(static_cast<int>(b), [&](const Eigen::Vector3d& p, int& label) {
+      if (std::abs(plane.first.dot(p) + plane.second) <= params.support_distance) label = block_labels[b];
+    });
   }
   // A region leaves out blocks whose centroids its noise tests put off the plane (a real
   // sensor's depth errors are correlated over many pixels), yet their points lie on it: from its
-  // blocks a plane's label spreads to the unlabelled blocks around them, to each pixel within
-  // kPixelBandSigmas of the sensor's depth noise of the plane, and on from a block where most
-  // points lie so. A surface off the plane (an object on a table) stops it.
+  // blocks a plane's label spreads to the unlabelled blocks around them, to each pixel whose depth
+  // lies within kPixelBandSigmas of the sensor's noise of where the plane meets its ray, and on
+  // from a block where most points lie so. A surface off the plane (an object on a table) stops it.
   std::vector<int> spread(block_labels), refused_for(block_labels.size(), -1);  // a block is tried once per plane
   std::vector<int> queue;
   for (size_t b = 0; b < spread.size(); ++b)
@@ -136,23 +140,15 @@ void labelPixels(const CloudView& cloud, const FrameData& frame, const std::vect
       const int b = n[1] * bx_count + n[0];
       if (spread[b] >= 0 || refused_for[b] == id || frame.points(b) <= 0) continue;
       int valid = 0, on_plane = 0;
-      for (int v = n[1] * s; v < (n[1] + 1) * s; ++v)
-        for (int u = n[0] * s; u < (n[0] + 1) * s; ++u)
-        {
-          float x, y, z;
-          cloud.point(u, v, x, y, z);
-          if (!std::isfinite(x + y + z)) continue;
-          ++valid;
-          // A depth error e moves the point along its ray by e / z of itself, off the plane by
-          // e |n . p| / z.
-          const Eigen::Vector3d p(x, y, z);
-          const double along_normal = plane.first.dot(p);
-          const double band = kPixelBandSigmas * frame.noise.sigma(z) * std::abs(along_normal) / z;
-          if (std::abs(along_normal + plane.second) > band) continue;
-          ++on_plane;
-          int& label = labels[static_cast<size_t>(v) * cloud.width + u];
-          if (label < 0) label = id;
-        }
+      forEachPoint(b, [&](const Eigen::Vector3d& p, int& label) {
+        ++valid;
+        // |n . p + d| = |n . p| / z * |z - expected depth|: the test in depth, as measured.
+        const double along_normal = plane.first.dot(p);
+        const double band = kPixelBandSigmas * frame.noise.sigma(p.z()) * std::abs(along_normal) / p.z();
+        if (std::abs(along_normal + plane.second) > band) return;
+        ++on_plane;
+        if (label < 0) label = id;
+      });
       if (valid > 0 && 2 * on_plane > valid)
       {
         spread[b] = id;
